@@ -1,0 +1,52 @@
+#include "apps/cli.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+
+namespace mrsnake::cli {
+
+GlobalOptions& global_options() {
+  static GlobalOptions options;
+  return options;
+}
+
+void info(const std::string& message) {
+  if (!global_options().quiet) std::cerr << message << '\n';
+}
+
+void warn(const std::string& message) { std::cerr << "mrsnake: warning: " << message << '\n'; }
+
+void print_json(const nlohmann::json& j) { std::cout << j.dump(2) << std::endl; }
+
+ProgressFn terminal_progress() {
+  if (global_options().quiet) return {};
+  const bool tty = isatty(STDERR_FILENO) != 0;
+  struct State {
+    std::string stage;
+    int percent = -1;
+    std::chrono::steady_clock::time_point last{};
+  };
+  auto state = std::make_shared<State>();
+  return [tty, state](const std::string& stage, double fraction) {
+    const int percent = static_cast<int>(fraction * 100.0 + 0.5);
+    if (tty) {
+      const auto now = std::chrono::steady_clock::now();
+      // Redraw at most every 50 ms, and always at a stage's start and end.
+      if (stage == state->stage && percent == state->percent) return;
+      if (stage == state->stage && percent < 100 && now - state->last < std::chrono::milliseconds(50)) return;
+      state->last = now;
+      std::fprintf(stderr, "\r\033[K%s %3d%%", stage.c_str(), percent);
+      if (percent >= 100) std::fputc('\n', stderr);
+      std::fflush(stderr);
+    } else if (stage != state->stage) {
+      std::fprintf(stderr, "%s...\n", stage.c_str());
+    }
+    state->stage = stage;
+    state->percent = percent;
+  };
+}
+
+}  // namespace mrsnake::cli

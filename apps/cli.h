@@ -1,0 +1,35 @@
+#pragma once
+/// \file cli.h
+/// What the subcommands share: registration, terminal progress and JSON output.
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <iosfwd>
+#include <string>
+
+#include "mesh/progress.h"
+
+namespace mrsnake::cli {
+
+/// Options every command has.
+struct GlobalOptions {
+  bool quiet = false;  ///< no progress and no informational messages
+};
+GlobalOptions& global_options();
+
+/// Progress drawn on stderr: a live line on a terminal, plain lines per stage otherwise,
+/// nothing with --quiet.
+ProgressFn terminal_progress();
+
+/// Informational message on stderr, unless --quiet.
+void info(const std::string& message);
+/// Warning on stderr (shown even with --quiet).
+void warn(const std::string& message);
+
+/// Prints JSON (pretty) to stdout.
+void print_json(const nlohmann::json& j);
+
+// One registration function per subcommand (apps/cmd_*.cpp).
+void add_info_command(CLI::App& app);
+
+}  // namespace mrsnake::cli

@@ -1,0 +1,39 @@
+// mrsnake: multiresolution snake segmentation with a prior shape model.
+#include <vtkObject.h>
+
+#include <iostream>
+
+#include "apps/cli.h"
+#include "mesh/errors.h"
+
+int main(int argc, char** argv) {
+  using namespace mrsnake;
+  // VTK would print its own multi-line errors for bad files; mrsnake reports them itself.
+  vtkObject::GlobalWarningDisplayOff();
+
+  CLI::App app{"mrsnake: fast 3D organ segmentation with a multiresolution snake and a prior shape model", "mrsnake"};
+  app.set_version_flag("--version", std::string("mrsnake ") + MRSNAKE_VERSION);
+  app.require_subcommand(1);
+  app.fallthrough();
+  app.add_flag("-q,--quiet", cli::global_options().quiet, "No progress or informational messages");
+  app.footer("Run 'mrsnake <command> --help' for a command's options and an example.");
+
+  cli::add_info_command(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : static_cast<int>(ExitCode::usage);
+  } catch (const Error& e) {
+    std::cerr << "mrsnake: error: " << e.what() << '\n';
+    return static_cast<int>(e.code());
+  } catch (const std::bad_alloc&) {
+    std::cerr << "mrsnake: error: out of memory; try a smaller input or fewer levels\n";
+    return static_cast<int>(ExitCode::failed);
+  } catch (const std::exception& e) {
+    std::cerr << "mrsnake: internal error: " << e.what() << " (please report this)\n";
+    return static_cast<int>(ExitCode::internal);
+  }
+  return 0;
+}

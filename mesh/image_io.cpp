@@ -1,0 +1,156 @@
+// ITK translation unit: no Eigen and no CGAL here (ITK bundles its own Eigen).
+#include "mesh/image_io.h"
+
+#include <itkGDCMImageIO.h>
+#include <itkGDCMImageIOFactory.h>
+#include <itkGDCMSeriesFileNames.h>
+#include <itkGiplImageIOFactory.h>
+#include <itkImage.h>
+#include <itkImageFileReader.h>
+#include <itkImageFileWriter.h>
+#include <itkImageIOFactory.h>
+#include <itkImageSeriesReader.h>
+#include <itkMetaImageIOFactory.h>
+#include <itkNiftiImageIOFactory.h>
+#include <itkNrrdImageIOFactory.h>
+
+#include <cmath>
+#include <filesystem>
+#include <mutex>
+
+#include "mesh/atomic_file.h"
+#include "mesh/errors.h"
+
+namespace mrsnake {
+namespace {
+
+using FloatImage = itk::Image<float, 3>;
+
+// Explicit registration: the project does not use ITK's generated factory-registration
+// headers, which need ITK's include path everywhere.
+void register_image_io() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    itk::NiftiImageIOFactory::RegisterOneFactory();
+    itk::NrrdImageIOFactory::RegisterOneFactory();
+    itk::MetaImageIOFactory::RegisterOneFactory();
+    itk::GiplImageIOFactory::RegisterOneFactory();
+    itk::GDCMImageIOFactory::RegisterOneFactory();
+  });
+}
+
+Volume to_volume(const FloatImage* image, const std::string& path) {
+  Volume v;
+  const auto region = image->GetLargestPossibleRegion();
+  for (int d = 0; d < 3; ++d) {
+    v.size[d] = region.GetSize()[d];
+    v.spacing[d] = image->GetSpacing()[d];
+    v.origin[d] = image->GetOrigin()[d];
+    for (int c = 0; c < 3; ++c) v.direction[3 * d + c] = image->GetDirection()(d, c);
+    if (!(std::isfinite(v.spacing[d]) && v.spacing[d] > 0))
+      throw InputError("'" + path + "' has a non-positive or non-finite voxel spacing; fix the image header");
+    if (!std::isfinite(v.origin[d]))
+      throw InputError("'" + path + "' has a non-finite origin; fix the image header");
+  }
+  v.data.assign(image->GetBufferPointer(), image->GetBufferPointer() + v.num_voxels());
+  return v;
+}
+
+Volume read_dicom_series(const std::string& dir) {
+  auto names = itk::GDCMSeriesFileNames::New();
+  names->SetUseSeriesDetails(true);
+  names->SetDirectory(dir);
+  const auto& series = names->GetSeriesUIDs();
+  if (series.empty()) throw InputError("folder '" + dir + "' holds no DICOM series; give an image file or a DICOM folder");
+  auto reader = itk::ImageSeriesReader<FloatImage>::New();
+  reader->SetImageIO(itk::GDCMImageIO::New());
+  reader->SetFileNames(names->GetFileNames(series.front()));
+  reader->Update();
+  return to_volume(reader->GetOutput(), dir);
+}
+
+}  // namespace
+
+Volume read_volume(const std::string& path) {
+  register_image_io();
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw InputError("image '" + path + "' does not exist; check the path");
+  try {
+    if (std::filesystem::is_directory(path, ec)) return read_dicom_series(path);
+    auto io = itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::ImageIOFactory::IOFileModeEnum::ReadMode);
+    if (!io) throw InputError("'" + path + "' is not an image format mrsnake reads (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)");
+    io->SetFileName(path);
+    io->ReadImageInformation();
+    const unsigned dims = io->GetNumberOfDimensions();
+    if (dims != 3) {
+      // NIfTI stores 3D images with trailing singleton dimensions as 4D; accept those.
+      bool singleton_tail = dims > 3;
+      for (unsigned d = 3; d < dims; ++d) singleton_tail = singleton_tail && io->GetDimensions(d) == 1;
+      if (!singleton_tail)
+        throw InputError("'" + path + "' is a " + std::to_string(dims) + "D image; mrsnake needs a 3D volume");
+    }
+    if (io->GetNumberOfComponents() != 1)
+      throw InputError("'" + path + "' has " + std::to_string(io->GetNumberOfComponents()) +
+                       " components per voxel; mrsnake needs a scalar image");
+    auto reader = itk::ImageFileReader<FloatImage>::New();
+    reader->SetFileName(path);
+    reader->SetImageIO(io);
+    reader->Update();
+    return to_volume(reader->GetOutput(), path);
+  } catch (const itk::ExceptionObject& e) {
+    throw InputError("cannot read image '" + path + "': " + std::string(e.GetDescription()) +
+                     "; the file may be corrupt or truncated");
+  }
+}
+
+void write_volume(const std::string& path, const Volume& volume, VoxelType type) {
+  register_image_io();
+  if (volume.data.size() != volume.num_voxels()) throw OutputError("internal: volume buffer does not match its size");
+  auto image = FloatImage::New();
+  FloatImage::RegionType region;
+  FloatImage::SpacingType spacing;
+  FloatImage::PointType origin;
+  FloatImage::DirectionType direction;
+  for (int d = 0; d < 3; ++d) {
+    region.SetSize(d, volume.size[d]);
+    spacing[d] = volume.spacing[d];
+    origin[d] = volume.origin[d];
+    for (int c = 0; c < 3; ++c) direction(d, c) = volume.direction[3 * d + c];
+  }
+  image->SetRegions(region);
+  image->SetSpacing(spacing);
+  image->SetOrigin(origin);
+  image->SetDirection(direction);
+  image->Allocate();
+  std::copy(volume.data.begin(), volume.data.end(), image->GetBufferPointer());
+
+  AtomicOutput out(path);
+  try {
+    auto write_as = [&](auto pixel) {
+      using Pixel = decltype(pixel);
+      using OutImage = itk::Image<Pixel, 3>;
+      auto cast = OutImage::New();
+      cast->CopyInformation(image);
+      cast->SetRegions(region);
+      cast->Allocate();
+      const float* src = image->GetBufferPointer();
+      Pixel* dst = cast->GetBufferPointer();
+      for (std::size_t i = 0; i < volume.num_voxels(); ++i) dst[i] = static_cast<Pixel>(src[i]);
+      auto writer = itk::ImageFileWriter<OutImage>::New();
+      writer->SetFileName(out.temp_path());
+      writer->SetInput(cast);
+      writer->SetUseCompression(true);
+      writer->Update();
+    };
+    switch (type) {
+      case VoxelType::uint8: write_as(std::uint8_t{}); break;
+      case VoxelType::int16: write_as(std::int16_t{}); break;
+      case VoxelType::float32: write_as(float{}); break;
+    }
+  } catch (const itk::ExceptionObject& e) {
+    throw OutputError("cannot write image '" + path + "': " + std::string(e.GetDescription()));
+  }
+  out.commit();
+}
+
+}  // namespace mrsnake

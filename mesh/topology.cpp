@@ -1,0 +1,214 @@
+#include "mesh/topology.h"
+
+#include <algorithm>
+#include <numeric>
+#include <unordered_map>
+
+#include <nlohmann/json.hpp>
+
+#include "mesh/errors.h"
+
+namespace mrsnake {
+namespace {
+
+struct UnionFind {
+  std::vector<int> parent;
+  explicit UnionFind(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void unite(int a, int b) { parent[find(a)] = find(b); }
+};
+
+std::uint64_t key(int a, int b) { return (static_cast<std::uint64_t>(a) << 32) | static_cast<std::uint32_t>(b); }
+
+}  // namespace
+
+bool TopologyReport::is_closed_genus0() const {
+  return components == 1 && is_manifold() && boundary_loops == 0 && genus == 0;
+}
+
+bool TopologyReport::is_disk() const {
+  return components == 1 && is_manifold() && boundary_loops == 1 && genus == 0;
+}
+
+std::string TopologyReport::describe() const {
+  if (faces == 0) return "an empty mesh";
+  std::string s;
+  if (is_closed_genus0()) return "a closed genus-0 surface";
+  if (is_disk()) return "a disk (one boundary loop)";
+  s = std::to_string(components) + (components == 1 ? " component" : " components");
+  if (genus) s += ", genus " + std::to_string(genus);
+  s += boundary_loops ? ", " + std::to_string(boundary_loops) + " boundary loop" + (boundary_loops > 1 ? "s" : "") : ", closed";
+  if (non_manifold_edges) s += ", " + std::to_string(non_manifold_edges) + " non-manifold edges";
+  if (non_manifold_vertices) s += ", " + std::to_string(non_manifold_vertices) + " non-manifold vertices";
+  return s;
+}
+
+TopologyReport topology_report(const TriMesh& mesh) {
+  TopologyReport r;
+  const int n = mesh.num_vertices();
+  const int m = mesh.num_faces();
+  r.vertices = n;
+  r.faces = m;
+  const double diag = bounding_box_diagonal(mesh.V);
+  const double area_eps = 1e-14 * diag * diag;
+
+  // Directed half-edges -> count; undirected edges -> face count.
+  std::unordered_map<std::uint64_t, int> directed, undirected;
+  directed.reserve(3 * m);
+  undirected.reserve(3 * m);
+  std::vector<char> used(n, 0);
+  UnionFind faces_uf(n);
+  for (int f = 0; f < m; ++f) {
+    const int a = mesh.F(f, 0), b = mesh.F(f, 1), c = mesh.F(f, 2);
+    if (a == b || b == c || c == a) {
+      ++r.degenerate_faces;
+    } else {
+      const Eigen::Vector3d e1 = mesh.V.row(b) - mesh.V.row(a), e2 = mesh.V.row(c) - mesh.V.row(a);
+      if (0.5 * e1.cross(e2).norm() <= area_eps) ++r.degenerate_faces;
+    }
+    for (int k = 0; k < 3; ++k) {
+      const int u = mesh.F(f, k), v = mesh.F(f, (k + 1) % 3);
+      used[u] = 1;
+      if (u == v) continue;
+      ++directed[key(u, v)];
+      ++undirected[key(std::min(u, v), std::max(u, v))];
+      faces_uf.unite(u, v);
+    }
+  }
+  r.referenced_vertices = static_cast<int>(std::count(used.begin(), used.end(), 1));
+  r.edges = static_cast<int>(undirected.size());
+
+  // Boundary edges and loops: boundary vertices are joined by boundary edges; a loop is a
+  // component of that graph (a vertex where two loops touch is counted non-manifold below).
+  UnionFind boundary_uf(n);
+  std::vector<char> on_boundary(n, 0);
+  for (const auto& [k, count] : undirected) {
+    const int u = static_cast<int>(k >> 32), v = static_cast<int>(k & 0xffffffffu);
+    if (count == 1) {
+      ++r.boundary_edges;
+      boundary_uf.unite(u, v);
+      on_boundary[u] = on_boundary[v] = 1;
+    } else if (count > 2) {
+      ++r.non_manifold_edges;
+    } else if (directed[key(u, v)] != 1) {
+      ++r.inconsistently_oriented_edges;
+    }
+  }
+  for (int v = 0; v < n; ++v)
+    if (on_boundary[v] && boundary_uf.find(v) == v) ++r.boundary_loops;
+  for (int v = 0; v < n; ++v)
+    if (used[v] && faces_uf.find(v) == v) ++r.components;
+
+  // Non-manifold vertices: the link (opposite edges of the incident faces) must be connected.
+  std::vector<std::vector<int>> incident(n);
+  for (int f = 0; f < m; ++f)
+    for (int k = 0; k < 3; ++k) incident[mesh.F(f, k)].push_back(f);
+  std::unordered_map<int, int> local;
+  for (int v = 0; v < n; ++v) {
+    if (incident[v].size() < 2) continue;
+    local.clear();
+    std::vector<int> parent;
+    auto id = [&](int w) {
+      auto [it, inserted] = local.try_emplace(w, static_cast<int>(parent.size()));
+      if (inserted) parent.push_back(it->second);
+      return it->second;
+    };
+    auto find = [&](int x) {
+      while (parent[x] != x) x = parent[x] = parent[parent[x]];
+      return x;
+    };
+    for (int f : incident[v]) {
+      int others[2], c = 0;
+      for (int k = 0; k < 3 && c < 2; ++k)
+        if (mesh.F(f, k) != v) others[c++] = mesh.F(f, k);
+      if (c < 2) continue;
+      const int a = id(others[0]), b = id(others[1]);
+      parent[find(a)] = find(b);
+    }
+    int fans = 0;
+    for (int x = 0; x < static_cast<int>(parent.size()); ++x)
+      if (find(x) == x) ++fans;
+    if (fans > 1) ++r.non_manifold_vertices;
+  }
+
+  r.euler_characteristic = r.referenced_vertices - r.edges + r.faces;
+  r.genus = (2 * r.components - r.euler_characteristic - r.boundary_loops) / 2;
+  return r;
+}
+
+std::vector<std::vector<int>> connected_components(const TriMesh& mesh) {
+  UnionFind uf(mesh.num_vertices());
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    uf.unite(mesh.F(f, 0), mesh.F(f, 1));
+    uf.unite(mesh.F(f, 1), mesh.F(f, 2));
+  }
+  std::unordered_map<int, int> index;
+  std::vector<std::vector<int>> comps;
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    const auto [it, inserted] = index.try_emplace(uf.find(mesh.F(f, 0)), static_cast<int>(comps.size()));
+    if (inserted) comps.emplace_back();
+    comps[it->second].push_back(f);
+  }
+  std::stable_sort(comps.begin(), comps.end(), [](const auto& a, const auto& b) { return a.size() > b.size(); });
+  return comps;
+}
+
+TriMesh extract_faces(const TriMesh& mesh, const std::vector<int>& faces) {
+  TriMesh sub;
+  sub.V = mesh.V;
+  sub.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+  for (std::size_t i = 0; i < faces.size(); ++i) sub.F.row(static_cast<Eigen::Index>(i)) = mesh.F.row(faces[i]);
+  return remove_unreferenced_vertices(sub);
+}
+
+TriMesh remove_unreferenced_vertices(const TriMesh& mesh) {
+  std::vector<int> remap(mesh.num_vertices(), -1);
+  for (int f = 0; f < mesh.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) remap[mesh.F(f, k)] = 0;
+  int next = 0;
+  for (int& r : remap)
+    if (r == 0) r = next++;
+  TriMesh out;
+  out.V.resize(next, 3);
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    if (remap[v] >= 0) out.V.row(remap[v]) = mesh.V.row(v);
+  out.F.resize(mesh.num_faces(), 3);
+  for (int f = 0; f < mesh.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) out.F(f, k) = remap[mesh.F(f, k)];
+  return out;
+}
+
+void require_disk_or_sphere(const TopologyReport& r, const std::string& what) {
+  if (r.is_disk() || r.is_closed_genus0()) return;
+  std::string advice;
+  if (r.faces == 0) advice = "the mesh is empty";
+  else if (r.components > 1) advice = "keep only the largest component (mrsnake mc does this)";
+  else if (!r.is_manifold()) advice = "repair the non-manifold parts first";
+  else if (r.genus > 0) advice = "close the handles (e.g. fill the label volume's tunnels) so it becomes genus 0";
+  else advice = "fill all holes but one, or close the surface";
+  throw TopologyError(what + " is " + r.describe() + ", but only a disk or a closed genus-0 surface can be parameterized; " + advice);
+}
+
+void to_json(nlohmann::json& j, const TopologyReport& r) {
+  j = nlohmann::json{{"vertices", r.vertices},
+                     {"referenced_vertices", r.referenced_vertices},
+                     {"faces", r.faces},
+                     {"edges", r.edges},
+                     {"boundary_edges", r.boundary_edges},
+                     {"boundary_loops", r.boundary_loops},
+                     {"components", r.components},
+                     {"euler_characteristic", r.euler_characteristic},
+                     {"genus", r.genus},
+                     {"non_manifold_edges", r.non_manifold_edges},
+                     {"non_manifold_vertices", r.non_manifold_vertices},
+                     {"degenerate_faces", r.degenerate_faces},
+                     {"inconsistently_oriented_edges", r.inconsistently_oriented_edges},
+                     {"is_manifold", r.is_manifold()},
+                     {"is_closed", r.is_closed()},
+                     {"type", r.describe()}};
+}
+
+}  // namespace mrsnake

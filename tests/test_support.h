@@ -1,0 +1,63 @@
+#pragma once
+// Shared helpers for the GoogleTest suites: the shared data folder and running the CLI.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+namespace mrsnake::test {
+
+/// The folder of real test data: $MRSNAKE_DATA, else ../shared/data beside the project.
+inline std::filesystem::path data_dir() {
+  if (const char* env = std::getenv("MRSNAKE_DATA"); env && *env) return env;
+  return std::filesystem::path(MRSNAKE_SOURCE_DIR) / ".." / "shared" / "data";
+}
+
+/// Path of a data file, or empty if the data folder or the file is absent.
+inline std::string data_file(const std::string& relative) {
+  const auto p = data_dir() / relative;
+  return std::filesystem::exists(p) ? p.string() : std::string();
+}
+
+/// A fresh scratch folder for one test.
+inline std::filesystem::path scratch_dir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("mrsnake-test-" + name + "-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  ///< stdout and stderr together
+};
+
+/// Runs the mrsnake executable (its path is in $MRSNAKE_BIN, set by ctest) with arguments.
+inline CommandResult run_mrsnake(const std::string& args) {
+  const char* bin = std::getenv("MRSNAKE_BIN");
+  CommandResult r;
+  if (!bin) {
+    r.output = "MRSNAKE_BIN is not set; run the tests through ctest";
+    return r;
+  }
+  const std::string cmd = std::string(bin) + " " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), static_cast<int>(buf.size()), pipe)) r.output += buf.data();
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+}  // namespace mrsnake::test
+
+/// Skips the test with a clear message when a shared data file is absent.
+#define MRSNAKE_REQUIRE_DATA(var, relative)                                                        \
+  const std::string var = ::mrsnake::test::data_file(relative);                                     \
+  if (var.empty())                                                                                  \
+    GTEST_SKIP() << "shared data file '" << relative << "' not found under "                       \
+                 << ::mrsnake::test::data_dir() << " (set MRSNAKE_DATA to the shared data folder)"
