@@ -1,0 +1,60 @@
+#pragma once
+/// \file distance.h
+/// Distances between surfaces and closest-point queries (CGAL AABB tree behind a small
+/// adapter: no CGAL type crosses this header).
+#include <memory>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "mesh/trimesh.h"
+
+namespace mrsnake {
+
+/// Closest points on a fixed triangle mesh. The tree is built once and reused.
+class SurfaceLocator {
+ public:
+  struct Hit {
+    Eigen::Vector3d point;        ///< closest point on the surface
+    int face = -1;                ///< the face that holds it
+    Eigen::Vector3d barycentric;  ///< its barycentric coordinates in that face
+    double distance = 0;
+  };
+  /// \pre mesh has at least one face.
+  explicit SurfaceLocator(const TriMesh& mesh);
+  ~SurfaceLocator();
+  SurfaceLocator(SurfaceLocator&&) noexcept;
+  SurfaceLocator& operator=(SurfaceLocator&&) noexcept;
+
+  Hit closest(const Eigen::Vector3d& p) const;
+  /// Unsigned distance from each row of P to the surface.
+  Eigen::VectorXd distances(const RowMatrixX3d& P) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Options for the Metro-style symmetric distance.
+struct DistanceOptions {
+  int samples_per_face = 10;  ///< random points per face, on top of every vertex
+  unsigned seed = 1;          ///< for reproducible sampling
+};
+
+/// Symmetric surface distance: every vertex plus samples_per_face random points per face
+/// of each mesh, measured against the other mesh, both directions pooled.
+struct SurfaceDistance {
+  double mean_mm = 0, rms_mm = 0, hausdorff_mm = 0;
+  double mean_pct = 0, rms_pct = 0, hausdorff_pct = 0;  ///< in % of the reference's bbox diagonal
+  double reference_diagonal_mm = 0;
+};
+
+/// \pre both meshes have at least one face.
+SurfaceDistance surface_distance(const TriMesh& mesh, const TriMesh& reference, const DistanceOptions& options = {});
+
+/// Number of pairs of faces that intersect (not counting neighbours that only share a
+/// vertex or an edge). 0 for a valid closed surface.
+int count_self_intersections(const TriMesh& mesh);
+
+void to_json(nlohmann::json& j, const SurfaceDistance& d);
+
+}  // namespace mrsnake

@@ -1,0 +1,42 @@
+#pragma once
+/// \file marching_cubes.h
+/// Surfaces from volumes (VTK flying edges), in physical coordinates: the image origin,
+/// spacing and direction matrix are applied to the output vertices.
+#include <string>
+#include <vector>
+
+#include "mesh/progress.h"
+#include "mesh/trimesh.h"
+#include "mesh/volume.h"
+
+namespace mrsnake {
+
+struct LabelSurfaceOptions {
+  int smoothing_iterations = 0;   ///< windowed-sinc iterations (volume-preserving); 0 = none
+  double smoothing_passband = 0.1;
+  bool keep_largest_component = true;
+};
+
+/// What was extracted, with anything worth a warning.
+struct LabelSurface {
+  TriMesh mesh;
+  int components_found = 0;        ///< connected components before keeping the largest
+  std::vector<int> dropped_component_faces;  ///< face counts of the dropped components
+};
+
+/// Extracts the surface of the voxels equal to `label` with discrete flying edges, oriented
+/// outward, optionally smoothed, keeping the largest component.
+/// \throw InputError if no voxel has the label (message lists the labels present), or if
+///        the surface is empty.
+LabelSurface extract_label_surface(const Volume& labels, int label, const LabelSurfaceOptions& options = {},
+                                   const ProgressFn& progress = {});
+
+/// The isosurface field == iso of a continuous field, oriented so that normals point to
+/// increasing values... unless `inside_is_greater`, in which case outward means decreasing.
+/// \throw InputError if the surface is empty.
+TriMesh extract_isosurface(const Volume& field, double iso, bool inside_is_greater = true);
+
+/// Enclosed volume of a closed, outward-oriented mesh (divergence theorem).
+double enclosed_volume(const TriMesh& mesh);
+
+}  // namespace mrsnake
