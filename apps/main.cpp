@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
   cli::add_info_command(app);
   cli::add_quality_command(app);
   cli::add_mc_command(app);
+  cli::add_synth_command(app);
+  cli::add_evaluate_command(app);
 
   try {
     app.parse(argc, argv);
