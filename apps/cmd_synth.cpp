@@ -9,6 +9,7 @@
 #include "mesh/errors.h"
 #include "mesh/image_io.h"
 #include "mesh/mesh_io.h"
+#include "mesh/topology.h"
 #include "snake/synth.h"
 
 namespace mrsnake::cli {
@@ -96,6 +97,11 @@ void add_synth_command(CLI::App& app) {
     SynthParams params;
     Volume source_image, source_labels;
     if (!a->params.empty()) {
+      for (const char* option : {"--shape", "--size", "--spacing", "--noise", "--snr", "--blur", "--bias", "--contrast", "--pose",
+                                 "--deform", "--seed", "--supersampling", "--label"})
+        if (cmd->count(option) > 0)
+          throw CLI::ValidationError(option, "--params regenerates the recorded case as it was; drop " + std::string(option) +
+                                                 " or drop --params");
       params = synth_params_from_json(read_json_file(a->params));
     } else {
       SynthOptions o;
@@ -151,6 +157,9 @@ void add_synth_command(CLI::App& app) {
     write_volume(image_path, r.image, VoxelType::float32);
     write_volume(truth_path, r.truth, VoxelType::uint8);
     write_mesh(mesh_path, r.truth_mesh);
+    const TopologyReport topology = topology_report(r.truth_mesh);
+    if (!topology.is_closed_genus0())
+      warn("the truth surface is " + topology.describe() + " (the label has several parts or holes)");
     nlohmann::json pj = params;
     write_text_file_atomically(params_path, pj.dump(2) + "\n");
 

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <functional>
 #include <limits>
 #include <random>
 #include <sstream>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -299,9 +301,31 @@ void degrade(Volume& image, const SynthParams& p, double contrast, const Progres
   }
 }
 
+/// Runs f(begin, end, is_first) on contiguous ranges of [0, n), one per hardware thread,
+/// and rethrows the first exception.
+void parallel_ranges(std::size_t n, const std::function<void(std::size_t, std::size_t, bool)>& f) {
+  const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 8);
+  const std::size_t parts = std::max<std::size_t>(1, std::min(threads, n / 4));
+  if (parts == 1) return f(0, n, true);
+  std::vector<std::exception_ptr> errors(parts);
+  std::vector<std::thread> pool;
+  for (std::size_t t = 0; t < parts; ++t)
+    pool.emplace_back([&, t] {
+      try {
+        f(n * t / parts, n * (t + 1) / parts, t == 0);
+      } catch (...) {
+        errors[t] = std::current_exception();
+      }
+    });
+  for (auto& th : pool) th.join();
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
 /// Moves each vertex onto the zero level of f by Newton steps along the gradient.
 void project_onto_surface(RowMatrixX3d& V, const std::function<double(const Eigen::Vector3d&)>& f, double h, double max_step) {
-  for (int v = 0; v < V.rows(); ++v) {
+  parallel_ranges(static_cast<std::size_t>(V.rows()), [&](std::size_t begin, std::size_t end, bool) {
+  for (int v = static_cast<int>(begin); v < static_cast<int>(end); ++v) {
     Eigen::Vector3d x = V.row(v).transpose();
     for (int it = 0; it < 10; ++it) {
       const double fx = f(x);
@@ -320,6 +344,7 @@ void project_onto_surface(RowMatrixX3d& V, const std::function<double(const Eige
     }
     V.row(v) = x.transpose();
   }
+  });
 }
 
 }  // namespace
@@ -493,8 +518,6 @@ SynthResult render_synth(const SynthParams& params, const ProgressFn& progress) 
 
   // Values at voxel corners, one z plane at a time (plane k holds the corners at k − 1/2).
   const std::size_t cx = nx + 1, cy = ny + 1;
-  std::vector<double> obj_lo(cx * cy), obj_hi(cx * cy), out_lo, out_hi;
-  if (heart) out_lo.resize(cx * cy), out_hi.resize(cx * cy);
   auto fill_plane = [&](double kz, std::vector<double>& obj, std::vector<double>& out) {
     for (std::size_t j = 0; j < cy; ++j)
       for (std::size_t i = 0; i < cx; ++i) {
@@ -517,40 +540,46 @@ SynthResult render_synth(const SynthParams& params, const ProgressFn& progress) 
         }
     return (neg && pos) || smallest < margin;
   };
-
-  fill_plane(-0.5, obj_lo, out_lo);
-  for (std::size_t k = 0; k < nz; ++k) {
-    report(progress, "synth: shape", static_cast<double>(k) / nz);
-    fill_plane(k + 0.5, obj_hi, out_hi);
-    for (std::size_t j = 0; j < ny; ++j)
-      for (std::size_t i = 0; i < nx; ++i) {
-        const Eigen::Vector3d c = voxel_centre(r.truth, i, j, k);
-        const double v = object(c);
-        const double w = heart ? outer(c) : 1.0;
-        const bool border = i < 2 || j < 2 || k < 2 || i + 2 >= nx || j + 2 >= ny || k + 2 >= nz;
-        if (border && v <= 0)
-          throw InputError("the " + to_string(params.shape.kind) +
-                           " does not fit inside the image (it reaches the border); use a larger --size or --spacing, "
-                           "a smaller --deform, or another --seed");
-        field.at(i, j, k) = static_cast<float>(v);
-        r.truth.at(i, j, k) = v < 0 ? kTruthLabel : (heart && w < 0 ? kWallLabel : 0);
-        const bool mixed = is_mixed(obj_lo, obj_hi, v, i, j) || (heart && is_mixed(out_lo, out_hi, w, i, j));
-        double value;
-        if (!mixed) {
-          value = v < 0 ? o.foreground : (heart ? (w < 0 ? o.background : mid) : o.background);
-        } else {  // partial volume: the mean intensity over n³ sub-voxel samples
-          double sum = 0;
-          for (int a = 0; a < n; ++a)
-            for (int b = 0; b < n; ++b)
-              for (int e = 0; e < n; ++e)
-                sum += tissue(voxel_centre(r.truth, i + (e + 0.5) / n - 0.5, j + (b + 0.5) / n - 0.5, k + (a + 0.5) / n - 0.5));
-          value = sum / (n * n * n);
+  // Slabs of z planes, one per thread; every voxel depends on the parameters only, so the
+  // result does not depend on the number of threads.
+  auto render_slab = [&](std::size_t k0, std::size_t k1, bool reports) {
+    std::vector<double> obj_lo(cx * cy), obj_hi(cx * cy), out_lo, out_hi;
+    if (heart) out_lo.resize(cx * cy), out_hi.resize(cx * cy);
+    fill_plane(k0 - 0.5, obj_lo, out_lo);
+    for (std::size_t k = k0; k < k1; ++k) {
+      if (reports) report(progress, "synth: shape", static_cast<double>(k - k0) / (k1 - k0));
+      fill_plane(k + 0.5, obj_hi, out_hi);
+      for (std::size_t j = 0; j < ny; ++j)
+        for (std::size_t i = 0; i < nx; ++i) {
+          const Eigen::Vector3d c = voxel_centre(r.truth, i, j, k);
+          const double v = object(c);
+          const double w = heart ? outer(c) : 1.0;
+          const bool border = i < 2 || j < 2 || k < 2 || i + 2 >= nx || j + 2 >= ny || k + 2 >= nz;
+          if (border && v <= 0)
+            throw InputError("the " + to_string(params.shape.kind) +
+                             " does not fit inside the image (it reaches the border); use a larger --size or --spacing, "
+                             "a smaller --deform, or another --seed");
+          field.at(i, j, k) = static_cast<float>(v);
+          r.truth.at(i, j, k) = v < 0 ? kTruthLabel : (heart && w < 0 ? kWallLabel : 0);
+          const bool mixed = is_mixed(obj_lo, obj_hi, v, i, j) || (heart && is_mixed(out_lo, out_hi, w, i, j));
+          double value;
+          if (!mixed) {
+            value = v < 0 ? o.foreground : (heart ? (w < 0 ? o.background : mid) : o.background);
+          } else {  // partial volume: the mean intensity over n³ sub-voxel samples
+            double sum = 0;
+            for (int a = 0; a < n; ++a)
+              for (int b = 0; b < n; ++b)
+                for (int e = 0; e < n; ++e)
+                  sum += tissue(voxel_centre(r.truth, i + (e + 0.5) / n - 0.5, j + (b + 0.5) / n - 0.5, k + (a + 0.5) / n - 0.5));
+            value = sum / (n * n * n);
+          }
+          r.image.at(i, j, k) = static_cast<float>(value);
         }
-        r.image.at(i, j, k) = static_cast<float>(value);
-      }
-    std::swap(obj_lo, obj_hi);
-    if (heart) std::swap(out_lo, out_hi);
-  }
+      std::swap(obj_lo, obj_hi);
+      if (heart) std::swap(out_lo, out_hi);
+    }
+  };
+  parallel_ranges(nz, [&](std::size_t k0, std::size_t k1, bool first) { render_slab(k0, k1, first); });
   report(progress, "synth: shape", 1.0);
 
   degrade(r.image, params, o.foreground - o.background, progress);

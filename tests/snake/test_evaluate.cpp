@@ -9,6 +9,8 @@
 
 #include "mesh/errors.h"
 #include "mesh/image_io.h"
+#include "mesh/mesh_io.h"
+#include "mesh/primitives.h"
 #include "snake/evaluate.h"
 #include "snake/image_filters_itk.h"
 #include "tests/test_support.h"
@@ -246,6 +248,21 @@ TEST(EvaluateCli, ScoresFilesAndRefusesBadInput) {
 
   auto label = test::run_mrsnake("evaluate --seg " + s + " --truth " + t + " --label 5");
   EXPECT_EQ(label.exit_code, 3) << label.output;
+
+  // Surfaces: concentric spheres 1 mm apart.
+  const std::string m1 = (dir / "r10.vtp").string(), m2 = (dir / "r11.vtp").string();
+  write_mesh(m1, icosphere(4, 10.0));
+  write_mesh(m2, icosphere(4, 11.0));
+  auto meshes = test::run_mrsnake("evaluate --seg-mesh " + m1 + " --truth-mesh " + m2 + " --json");
+  ASSERT_EQ(meshes.exit_code, 0) << meshes.output;
+  const auto jm = nlohmann::json::parse(meshes.output).at("surface_distance");
+  EXPECT_NEAR(jm.at("mean_mm").get<double>(), 1.0, 0.05);
+  EXPECT_NEAR(jm.at("hausdorff_mm").get<double>(), 1.0, 0.1);
+  auto both = test::run_mrsnake("evaluate --seg " + s + " --truth " + t + " --seg-mesh " + m1 + " --truth-mesh " + m1 + " --json");
+  ASSERT_EQ(both.exit_code, 0) << both.output;
+  const auto jb = nlohmann::json::parse(both.output);
+  EXPECT_TRUE(jb.contains("dice"));
+  EXPECT_NEAR(jb.at("surface_distance").at("hausdorff_mm").get<double>(), 0.0, 1e-9);
 
   auto nothing = test::run_mrsnake("evaluate");
   EXPECT_EQ(nothing.exit_code, 2) << nothing.output;

@@ -378,6 +378,7 @@ TEST(SynthCli, BadInputExitCodes) {
   EXPECT_EQ(missing.exit_code, 3) << missing.output;
   EXPECT_NE(missing.output.find("does not exist"), std::string::npos) << missing.output;
   EXPECT_EQ(test::run_mrsnake("synth --params " + (dir / "none.json").string() + out).exit_code, 3);
+  EXPECT_EQ(test::run_mrsnake("synth --params " + (dir / "none.json").string() + " --seed 3" + out).exit_code, 2);
   EXPECT_FALSE(std::filesystem::exists(dir / "x" / "image.nii.gz"));
   std::filesystem::remove_all(dir);
 }
