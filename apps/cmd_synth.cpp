@@ -130,6 +130,9 @@ void add_synth_command(CLI::App& app) {
         o.foreground = fb[0];
         o.background = fb[1];
       } else {
+        for (const char* option : {"--shape", "--size", "--spacing", "--contrast", "--supersampling"})
+          if (cmd->count(option) > 0)
+            throw CLI::ValidationError(option, std::string(option) + " does not apply to --from-image, which keeps the grid and intensities of the image");
         // A real image already has its noise and blur: add none unless asked.
         if (cmd->count("--noise") == 0 && cmd->count("--snr") == 0) o.noise = SynthNoise::none;
         if (cmd->count("--blur") == 0) o.blur_mm = 0;

@@ -325,25 +325,25 @@ void parallel_ranges(std::size_t n, const std::function<void(std::size_t, std::s
 /// Moves each vertex onto the zero level of f by Newton steps along the gradient.
 void project_onto_surface(RowMatrixX3d& V, const std::function<double(const Eigen::Vector3d&)>& f, double h, double max_step) {
   parallel_ranges(static_cast<std::size_t>(V.rows()), [&](std::size_t begin, std::size_t end, bool) {
-  for (int v = static_cast<int>(begin); v < static_cast<int>(end); ++v) {
-    Eigen::Vector3d x = V.row(v).transpose();
-    for (int it = 0; it < 10; ++it) {
-      const double fx = f(x);
-      if (std::abs(fx) < 1e-9) break;
-      Eigen::Vector3d g;
-      for (int d = 0; d < 3; ++d) {
-        Eigen::Vector3d e = Eigen::Vector3d::Zero();
-        e[d] = h;
-        g[d] = (f(x + e) - f(x - e)) / (2 * h);
+    for (int v = static_cast<int>(begin); v < static_cast<int>(end); ++v) {
+      Eigen::Vector3d x = V.row(v).transpose();
+      for (int it = 0; it < 10; ++it) {
+        const double fx = f(x);
+        if (std::abs(fx) < 1e-9) break;
+        Eigen::Vector3d g;
+        for (int d = 0; d < 3; ++d) {
+          Eigen::Vector3d e = Eigen::Vector3d::Zero();
+          e[d] = h;
+          g[d] = (f(x + e) - f(x - e)) / (2 * h);
+        }
+        const double g2 = g.squaredNorm();
+        if (g2 < 1e-12) break;
+        Eigen::Vector3d step = fx * g / g2;
+        if (step.norm() > max_step) step *= max_step / step.norm();
+        x -= step;
       }
-      const double g2 = g.squaredNorm();
-      if (g2 < 1e-12) break;
-      Eigen::Vector3d step = fx * g / g2;
-      if (step.norm() > max_step) step *= max_step / step.norm();
-      x -= step;
+      V.row(v) = x.transpose();
     }
-    V.row(v) = x.transpose();
-  }
   });
 }
 

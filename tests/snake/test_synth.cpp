@@ -370,6 +370,7 @@ TEST(SynthCli, BadInputExitCodes) {
   EXPECT_EQ(test::run_mrsnake("synth --size 4,4" + out).exit_code, 2);
   EXPECT_EQ(test::run_mrsnake("synth --contrast 200" + out).exit_code, 2);
   EXPECT_EQ(test::run_mrsnake("synth --size 4" + out).exit_code, 3);
+  EXPECT_EQ(test::run_mrsnake("synth --from-image a.nii.gz --from-labels b.nii.gz --size 32" + out).exit_code, 2);
   auto fold = test::run_mrsnake("synth --deform 40" + out);
   EXPECT_EQ(fold.exit_code, 3);
   EXPECT_NE(fold.output.find("--deform"), std::string::npos) << fold.output;
@@ -392,7 +393,13 @@ TEST(SynthFromImage, NoWarpReproducesTheSourceAndAWarpIsExactlyKnown) {
   src.size = {48, 44, 40};
   src.spacing = {1.0, 1.2, 1.1};
   const SynthResult source = render_synth(draw_synth_params(src));
-  Volume labels = source.truth;
+  // Placed with a rotated direction matrix and an offset origin: all geometry is physical.
+  SynthResult placed = source;
+  for (Volume* v : {&placed.image, &placed.truth}) {
+    v->direction = {0, -1, 0, 1, 0, 0, 0, 0, 1};
+    v->origin = {12, -30, 7};
+  }
+  Volume labels = placed.truth;
   for (float& v : labels.data) v = v == kTruthLabel ? 3.0f : 0.0f;
   Volume mask = labels;
   for (float& v : mask.data) v = v == 3.0f ? 1.0f : 0.0f;
@@ -403,14 +410,16 @@ TEST(SynthFromImage, NoWarpReproducesTheSourceAndAWarpIsExactlyKnown) {
   o.source_label = 3;
   o.noise = SynthNoise::none;
   o.blur_mm = 0;
-  const SynthResult same = render_from_image(draw_synth_params(o, &mask), source.image, labels);
+  const SynthResult same = render_from_image(draw_synth_params(o, &mask), placed.image, labels);
   EXPECT_EQ(same.truth.data, object_mask(source.truth).data);
+  EXPECT_EQ(same.truth.direction, labels.direction);
+  EXPECT_EQ(same.truth.origin, labels.origin);
   for (std::size_t i = 0; i < same.image.data.size(); ++i) ASSERT_NEAR(same.image.data[i], source.image.data[i], 1e-3);
 
   o.deform_mm = 3;
   o.random_pose = true;
   const SynthParams p = draw_synth_params(o, &mask);
-  const SynthResult warped = render_from_image(p, source.image, labels);
+  const SynthResult warped = render_from_image(p, placed.image, labels);
   // truth(x) = [mask interpolated at M(x) >= 0.5], checked here with our own interpolation.
   std::size_t checked = 0, wrong = 0, changed = 0;
   for (std::size_t k = 0; k < mask.size[2]; ++k)
@@ -431,6 +440,18 @@ TEST(SynthFromImage, NoWarpReproducesTheSourceAndAWarpIsExactlyKnown) {
   double on = 0;
   for (int v = 0; v < warped.truth_mesh.num_vertices(); ++v) on += trilinear(warped.truth, warped.truth_mesh.V.row(v).transpose());
   EXPECT_NEAR(on / warped.truth_mesh.num_vertices(), 0.5, 0.05);
+  // The pose turns about the object's centroid (physical), so the object stays in view.
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  std::size_t count = 0;
+  for (std::size_t k = 0; k < mask.size[2]; ++k)
+    for (std::size_t j = 0; j < mask.size[1]; ++j)
+      for (std::size_t i = 0; i < mask.size[0]; ++i)
+        if (mask.at(i, j, k) != 0) {
+          const auto c = mask.index_to_physical(i, j, k);
+          centroid += Eigen::Vector3d(c[0], c[1], c[2]);
+          ++count;
+        }
+  EXPECT_LT((p.pose.centre - centroid / count).norm(), 1e-6);
 }
 
 TEST(SynthFromImage, RealBrainMriHippocampus) {
