@@ -160,6 +160,29 @@ TEST(Synth, HeartMarksCavityAndWall) {
   EXPECT_EQ(j.at("wall_label").get<int>(), 2);
 }
 
+TEST(Synth, ThresholdingTheImageRecoversTheTruth) {
+  // End to end with evaluate: a blurred, noisy blob thresholded half-way between the two
+  // intensities is close to its truth.
+  SynthOptions o;
+  o.shape = SynthShape::blob;
+  o.blur_mm = 1.0;
+  o.snr = 10;
+  o.random_pose = true;
+  o.deform_mm = 3;
+  o.seed = 4;
+  const SynthResult r = render_synth(draw_synth_params(o));
+  Volume seg = r.image;
+  for (float& v : seg.data) v = v > 0.5 * (o.foreground + o.background) ? 1.0f : 0.0f;
+  const SegmentationScores s = evaluate_segmentation(seg, r.truth);
+  std::cout << "threshold of a blob (blur 1 mm, snr 10): dice " << s.dice << ", volume difference "
+            << s.volume_difference_pct << " %, assd " << s.assd_mm << " mm, hd95 " << s.hd95_mm << " mm, hausdorff "
+            << s.hausdorff_mm << " mm\n";
+  EXPECT_GT(s.dice, 0.97);
+  EXPECT_LT(std::abs(s.volume_difference_pct), 3.0);
+  EXPECT_LT(s.assd_mm, 0.5);
+  EXPECT_LE(s.hd95_mm, 1.0);
+}
+
 // --- noise, bias and blur -------------------------------------------------------------------
 
 TEST(Synth, GaussianNoiseHasTheRequestedSnr) {
