@@ -490,6 +490,10 @@ TEST(SynthFromImage, RealBrainMriHippocampus) {
   EXPECT_GT(nlohmann::json::parse(r.output).at("object_voxels").get<int>(), 500);
   const auto params = nlohmann::json::parse(file_bytes(dir / "params.json"));
   EXPECT_EQ(params.at("source").at("label").get<int>(), 4);
+  auto again = test::run_mrsnake("-q synth --params " + (dir / "params.json").string() + " -o " + (dir / "again").string());
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_EQ(out.data, read_volume((dir / "again" / "image.nii.gz").string()).data);
+  EXPECT_EQ(read_volume((dir / "truth.nii.gz").string()).data, read_volume((dir / "again" / "truth.nii.gz").string()).data);
   auto absent = test::run_mrsnake("synth --from-image " + image + " --from-labels " + labels + " --label 77 -o " +
                                   (dir / "absent").string());
   EXPECT_EQ(absent.exit_code, 3) << absent.output;
