@@ -499,11 +499,16 @@ SynthResult render_synth(const SynthParams& params, const ProgressFn& progress) 
   const bool heart = params.shape.kind == SynthShape::heart;
   const double s = params.pose.scale;
   auto object = [&](const Eigen::Vector3d& p) { return s * shape_function(params.shape, params.to_reference(p)); };
-  auto outer = [&](const Eigen::Vector3d& p) { return s * heart_outer_function(params.shape, params.to_reference(p)); };
+  // The object's and (heart) the outer wall's functions, sharing one mapping of the point.
+  auto both = [&](const Eigen::Vector3d& p) {
+    const Eigen::Vector3d x = params.to_reference(p);
+    return std::pair<double, double>(s * shape_function(params.shape, x), heart ? s * heart_outer_function(params.shape, x) : 1.0);
+  };
   const double mid = 0.5 * (o.foreground + o.background);
   auto tissue = [&](const Eigen::Vector3d& p) {
-    if (object(p) < 0) return o.foreground;
-    if (heart) return outer(p) < 0 ? o.background : mid;
+    const auto [v, w] = both(p);
+    if (v < 0) return o.foreground;
+    if (heart) return w < 0 ? o.background : mid;
     return o.background;
   };
 
@@ -522,8 +527,9 @@ SynthResult render_synth(const SynthParams& params, const ProgressFn& progress) 
     for (std::size_t j = 0; j < cy; ++j)
       for (std::size_t i = 0; i < cx; ++i) {
         const Eigen::Vector3d c = voxel_centre(r.truth, i - 0.5, j - 0.5, kz);
-        obj[i + cx * j] = object(c);
-        if (heart) out[i + cx * j] = outer(c);
+        const auto [v, w] = both(c);
+        obj[i + cx * j] = v;
+        if (heart) out[i + cx * j] = w;
       }
   };
   auto is_mixed = [&](const std::vector<double>& lo, const std::vector<double>& hi, double centre_value, std::size_t i,
@@ -552,8 +558,7 @@ SynthResult render_synth(const SynthParams& params, const ProgressFn& progress) 
       for (std::size_t j = 0; j < ny; ++j)
         for (std::size_t i = 0; i < nx; ++i) {
           const Eigen::Vector3d c = voxel_centre(r.truth, i, j, k);
-          const double v = object(c);
-          const double w = heart ? outer(c) : 1.0;
+          const auto [v, w] = both(c);
           const bool border = i < 2 || j < 2 || k < 2 || i + 2 >= nx || j + 2 >= ny || k + 2 >= nz;
           if (border && v <= 0)
             throw InputError("the " + to_string(params.shape.kind) +
