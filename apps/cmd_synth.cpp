@@ -80,7 +80,7 @@ void add_synth_command(CLI::App& app) {
   cmd->add_option("--deform", a->deform, "Largest displacement in mm of a random smooth deformation (0: none)")->capture_default_str();
   cmd->add_option("--seed", a->seed, "Random seed: the same seed gives the same case")->capture_default_str();
   cmd->add_option("--supersampling", a->supersampling, "Partial volume: N^3 samples per boundary voxel")->capture_default_str();
-  auto* from_image = cmd->add_option("--from-image", a->from_image, "Warp this real image instead of rendering a shape");
+  auto* from_image = cmd->add_option("--from-image", a->from_image, "Warp this real image instead of rendering a shape (adds no noise or blur unless --noise, --snr or --blur is given)");
   auto* from_labels = cmd->add_option("--from-labels", a->from_labels, "The label volume of --from-image");
   cmd->add_option("--label", a->label, "The label of --from-labels that becomes the truth")->capture_default_str();
   auto* params = cmd->add_option("--params", a->params, "Regenerate the case recorded in this params.json");

@@ -233,7 +233,7 @@ DeformationParams draw_deformation(double amplitude, const Eigen::Vector3d& lo, 
     u.centres.push_back(c);
     u.displacements.push_back(rng.in_ball(1.0));
   }
-  const int n = 20;
+  const int n = 32;  // samples per axis of the box: under a third of the bump width apart
   auto sample = [&](int i, int j, int k) {
     return Eigen::Vector3d(box_lo.x() + (box_hi.x() - box_lo.x()) * i / (n - 1), box_lo.y() + (box_hi.y() - box_lo.y()) * j / (n - 1),
                            box_lo.z() + (box_hi.z() - box_lo.z()) * k / (n - 1));
@@ -243,7 +243,8 @@ DeformationParams draw_deformation(double amplitude, const Eigen::Vector3d& lo, 
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) largest = std::max(largest, u.displacement(sample(i, j, k)).norm());
   for (auto& d : u.displacements) d *= amplitude / std::max(largest, 1e-12);
-  // p -> p + u(p) is the identity far away; positive Jacobians make it a diffeomorphism.
+  // p -> p + u(p) is the identity far away; with positive Jacobians everywhere it is a
+  // diffeomorphism. They are checked on the samples and at the bump centres, with a margin.
   double smallest_det = std::numeric_limits<double>::infinity();
   for (int k = 0; k < n; ++k)
     for (int j = 0; j < n; ++j)
