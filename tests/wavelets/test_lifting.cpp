@@ -108,7 +108,9 @@ TEST(Lifting, DetailEnergyShrinksWithTheLevelOnSmoothShapes) {
         EXPECT_EQ(a.stats[j].level, static_cast<int>(j) + 1);
         EXPECT_EQ(a.stats[j].count, h.conn.vertex_counts[j + 1] - h.conn.vertex_counts[j]);
         EXPECT_NEAR(a.stats[j].rms, std::sqrt(a.stats[j].energy / a.stats[j].count), 1e-12);
-        if (j > 0) EXPECT_LT(a.stats[j].rms, 0.6 * a.stats[j - 1].rms) << h.name << " " << to_string(p) << " level " << j + 1;
+        if (j > 0) {
+          EXPECT_LT(a.stats[j].rms, 0.6 * a.stats[j - 1].rms) << h.name << " " << to_string(p) << " level " << j + 1;
+        }
       }
     }
   }
