@@ -271,19 +271,10 @@ void save_model(const std::string& folder, const ShapeModel& model, const Progre
     if (!is_model)
       throw OutputError("'" + final_path.string() + "' exists and is not a model folder; choose another output path or remove it");
   }
-  const std::string stem = final_path.filename().string();
-  const fs::path temp = parent / ("." + stem + ".tmp-" + std::to_string(getpid()));
-  fs::remove_all(temp, ec);
-  if (!fs::create_directory(temp, ec) || ec)
-    throw OutputError("cannot create the folder '" + temp.string() + "': " + ec.message());
-  struct Cleanup {
-    fs::path path;
-    bool active = true;
-    ~Cleanup() {
-      std::error_code e;
-      if (active) fs::remove_all(path, e);
-    }
-  } cleanup{temp};
+  // Written into a temporary folder beside the final one, renamed into place at the end
+  // (and removed on an error or an interrupt).
+  AtomicDirectory out(final_path.string());
+  const fs::path temp = out.temp_path();
 
   report(progress, "write model", 0.0);
   nlohmann::json files;
@@ -340,23 +331,7 @@ void save_model(const std::string& folder, const ShapeModel& model, const Progre
     return std::vector<std::uint8_t>(text.begin(), text.end());
   }());
 
-  // Swap into place: an existing model moves aside first and is removed at the end.
-  const fs::path old = parent / ("." + stem + ".old-" + std::to_string(getpid()));
-  bool moved_old = false;
-  if (fs::exists(final_path, ec)) {
-    fs::remove_all(old, ec);
-    fs::rename(final_path, old, ec);
-    if (ec) throw OutputError("cannot replace the model at '" + final_path.string() + "': " + ec.message());
-    moved_old = true;
-  }
-  fs::rename(temp, final_path, ec);
-  if (ec) {
-    std::error_code ignore;
-    if (moved_old) fs::rename(old, final_path, ignore);
-    throw OutputError("cannot move the model into place at '" + final_path.string() + "': " + ec.message());
-  }
-  cleanup.active = false;
-  if (moved_old) fs::remove_all(old, ec);
+  out.commit();
   report(progress, "write model", 1.0);
 }
 
