@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   app.footer("Run 'mrsnake <command> --help' for a command's options and an example.");
 
   cli::add_info_command(app);
+  cli::add_quality_command(app);
 
   try {
     app.parse(argc, argv);
