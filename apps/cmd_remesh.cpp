@@ -17,7 +17,7 @@ void add_remesh_command(CLI::App& app) {
                                  "(level_0.vtp ... level_L.vtp and report.json)");
   struct Args {
     std::string mesh, out;
-    int levels = 0, faces = 16000, base_vertices = 32, iterations = 8;
+    int levels = 0, faces = 16000, base_vertices = 32, iterations = 8, shape_iterations = 3;
     double exponent = 2.0;
     bool no_relax = false, strict = false, json = false;
   };
@@ -40,6 +40,9 @@ void add_remesh_command(CLI::App& app) {
   cmd->add_option("--density-exponent", args->exponent, "Lloyd density = stretch^e (default 2: even 3D spacing)")
       ->check(CLI::Range(0.0, 8.0));
   cmd->add_option("--iterations", args->iterations, "Lloyd iterations per level (default 8)")->check(CLI::Range(0, 1000));
+  cmd->add_option("--shape-iterations", args->shape_iterations,
+                  "Iterations per level of 3D shape smoothing after Lloyd (default 3; not with --strict or --no-relax)")
+      ->check(CLI::Range(0, 1000));
   cmd->add_flag("--json", args->json, "Print report.json to stdout");
   cmd->footer("Example: mrsnake remesh liver.vtp -o liver_model --faces 16000");
   cmd->callback([args] {
@@ -50,6 +53,7 @@ void add_remesh_command(CLI::App& app) {
     options.base_vertices = args->base_vertices;
     options.lloyd_iterations = args->iterations;
     options.density_exponent = args->exponent;
+    options.shape_iterations = args->shape_iterations;
     options.relax = args->no_relax ? RelaxMode::none : args->strict ? RelaxMode::new_vertices_only : RelaxMode::all_vertices;
     if (!global_options().quiet) options.progress = terminal_progress();
     const RemeshResult result = remesh(input, options);

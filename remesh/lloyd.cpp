@@ -69,7 +69,7 @@ LloydStats constrained_lloyd(DomainKind kind, const RowMatrixX3i& F, const Densi
   const VertexFaces star(F, n);
   std::vector<int> face_hint(m);
   for (int f = 0; f < m; ++f) face_hint[f] = vertex_hints[F(f, 0)];
-  const int r = static_cast<int>(std::floor(std::sqrt(static_cast<double>(options.sample_budget) / std::max(1, m))));
+  const int r = std::min(48, static_cast<int>(std::floor(std::sqrt(static_cast<double>(options.sample_budget) / std::max(1, m)))));
 
   Eigen::VectorXd mass(n);
   RowMatrixX3d moment(n, 3);

@@ -107,7 +107,7 @@ Parameterization parameterize(const TriMesh& input) {
   param.surface = remove_unreferenced_vertices(input);
   const TriMesh& mesh = param.surface;
   const TopologyReport topo = topology_report(mesh);
-  require_disk_or_sphere(topo, "remesh");
+  require_disk_or_sphere(topo, "the input surface");
   const int n = mesh.num_vertices();
   param.domain.resize(n, 3);
   int balance_iterations = 0;

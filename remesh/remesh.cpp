@@ -12,6 +12,7 @@
 #include "remesh/lift.h"
 #include "remesh/lloyd.h"
 #include "remesh/parameterization.h"
+#include "remesh/shape_smoothing.h"
 
 namespace mrsnake {
 namespace {
@@ -46,6 +47,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   if (options.levels < 0 || options.levels > 12) throw std::invalid_argument("levels must be in [0, 12]");
   if (options.levels == 0 && options.target_faces < 16) throw std::invalid_argument("target_faces must be at least 16");
   if (options.lloyd_iterations < 0) throw std::invalid_argument("lloyd_iterations must be >= 0");
+  if (options.shape_iterations < 0) throw std::invalid_argument("shape_iterations must be >= 0");
   if (options.base_vertices < 6) throw std::invalid_argument("base_vertices must be at least 6");
   if (!(options.density_exponent >= 0 && options.density_exponent <= 8))
     throw std::invalid_argument("density_exponent must be in [0, 8]");
@@ -103,12 +105,18 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       relax_stats = constrained_lloyd(kind, F, density, U, hints, lloyd);
     }
     report(options.progress, "level " + std::to_string(j), 0.5);
+    RemeshLevel level;
+    level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
+    int shape_moves = 0;
+    if (options.relax == RelaxMode::all_vertices && options.shape_iterations > 0) {
+      ShapeSmoothingOptions shape;
+      shape.iterations = options.shape_iterations;
+      shape_moves = smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, shape);
+    }
     const int flipped = count_flipped(U, F);
     if (flipped > 0)
       throw AlgorithmError("level " + std::to_string(j) + " has " + std::to_string(flipped) +
                            " flipped triangles in the domain; the surface cannot be remeshed well");
-    RemeshLevel level;
-    level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
     level.domain_positions = U;
     level.flipped_triangles = flipped;
     level.seconds = seconds_since(start) + (j == 0 ? setup_seconds : 0.0);
@@ -121,6 +129,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     s["lloyd_shortened_moves"] = relax_stats.shortened_moves;
     s["lloyd_rejected_moves"] = relax_stats.rejected_moves;
     s["lloyd_last_mean_shift"] = relax_stats.mean_shift;
+    s["shape_moves"] = shape_moves;
     if (options.compute_stats) {
       const TriMesh mesh{level.positions, F};
       s["quality"] = mesh_quality(mesh);
@@ -139,6 +148,7 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["relax"] = relax_name(options.relax);
   j["density_exponent"] = options.density_exponent;
   j["lloyd_iterations"] = options.lloyd_iterations;
+  j["shape_iterations"] = options.relax == RelaxMode::all_vertices ? options.shape_iterations : 0;
   j["parameterization"] = result.parameterization;
   double total = result.parameterization.value("seconds", 0.0);
   nlohmann::json per_level = nlohmann::json::array();

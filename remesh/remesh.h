@@ -40,6 +40,10 @@ struct RemeshOptions {
   double density_exponent = 2.0;
   /// Lloyd iterations per level (level 0 included unless relax == new_vertices_only).
   int lloyd_iterations = 8;
+  /// With all_vertices: iterations per level of tangential smoothing toward equilateral 3D
+  /// triangles, moved in D (remesh/shape_smoothing.h). The Lloyd step evens out sizes but is
+  /// affine invariant, so it cannot repair shear; this can. 0 = the Lloyd step alone.
+  int shape_iterations = 3;
   /// Compute quality and distance per level into RemeshLevel::stats (costs time).
   bool compute_stats = true;
   ProgressFn progress;
