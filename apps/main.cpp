@@ -21,10 +21,13 @@ int main(int argc, char** argv) {
   app.footer("Run 'mrsnake <command> --help' for a command's options and an example.");
 
   cli::add_info_command(app);
+  cli::add_model_info_command(app);
   cli::add_quality_command(app);
   cli::add_mc_command(app);
   cli::add_synth_command(app);
   cli::add_evaluate_command(app);
+  cli::add_remesh_command(app);
+  cli::add_build_model_command(app);
 
   try {
     app.parse(argc, argv);
