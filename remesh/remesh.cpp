@@ -1,6 +1,9 @@
 #include "remesh/remesh.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <stdexcept>
 
@@ -30,11 +33,13 @@ const char* relax_name(RelaxMode mode) {
   return "?";
 }
 
-// Levels L and base size n0 so that F0·4^L is near the target, with F0 in [40, 160).
+// Levels L and base size n0 so that F0·4^L is near the target, with F0 in [128, 512): a base
+// of ~65-260 vertices spread over the shape absorbs its curvature, and since about half of
+// them are irregular, they stay under 1% of the finest level's vertices.
 void choose_resolution(int target_faces, int& levels, int& n0) {
   levels = 1;
   double f0 = target_faces / 4.0;
-  while (f0 >= 160) {
+  while (f0 >= 512) {
     f0 /= 4;
     ++levels;
   }
@@ -71,6 +76,14 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   result.parameterization["base_faces"] = base.faces.rows();
   result.parameterization["base_valence_flips"] = base.valence_flips;
 
+  if (std::getenv("MRSNAKE_REMESH_DEBUG")) {
+    std::vector<int> val(n0, 0);
+    for (int f = 0; f < base.faces.rows(); ++f)
+      for (int k = 0; k < 3; ++k) ++val[base.faces(f, k)];
+    const auto bd = boundary_vertices(base.faces, n0);
+    for (int v = 0; v < n0; ++v) std::fprintf(stderr, "%s%d ", bd[v] ? "b" : "", val[v] + (bd[v] ? 1 : 0));
+    std::fprintf(stderr, "\n");
+  }
   const DomainMesh domain_mesh(param.domain, param.surface.F);
   DensityField density{&domain_mesh, param.vertex_stretch.array().pow(options.density_exponent).matrix()};
   const DomainKind kind = param.kind;
@@ -134,6 +147,27 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       const TriMesh mesh{level.positions, F};
       s["quality"] = mesh_quality(mesh);
       s["distance"] = surface_distance(mesh, param.surface);
+    }
+    if (std::getenv("MRSNAKE_REMESH_DEBUG") && j == levels) {
+      const TriMesh mesh{level.positions, F};
+      std::vector<int> valence(U.rows(), 0);
+      for (int f = 0; f < F.rows(); ++f)
+        for (int k = 0; k < 3; ++k) ++valence[F(f, k)];
+      std::vector<std::pair<double, int>> q;
+      for (int f = 0; f < F.rows(); ++f)
+        q.push_back({frey_borouchaki_quality(mesh.V.row(F(f, 0)), mesh.V.row(F(f, 1)), mesh.V.row(F(f, 2))), f});
+      std::sort(q.begin(), q.end());
+      for (int i = 0; i < 15; ++i) {
+        const int f = q[i].second;
+        std::fprintf(stderr, "Q %.3f face %d:", q[i].first, f);
+        for (int k = 0; k < 3; ++k) {
+          const int v = F(f, k);
+          const int pf = hints[v];
+          std::fprintf(stderr, " v%d(lvl %d val %d stretch %.3g x %.3f %.3f %.3f)", v, result.connectivity.level_of_vertex(v), valence[v],
+                       param.face_stretch[pf], mesh.V(v, 0), mesh.V(v, 1), mesh.V(v, 2));
+        }
+        std::fprintf(stderr, "\n");
+      }
     }
     result.levels.push_back(std::move(level));
     report(options.progress, "level " + std::to_string(j), 1.0);
