@@ -33,5 +33,6 @@ void print_json(const nlohmann::json& j);
 void add_info_command(CLI::App& app);
 void add_quality_command(CLI::App& app);
 void add_remesh_command(CLI::App& app);
+void add_mc_command(CLI::App& app);
 
 }  // namespace mrsnake::cli

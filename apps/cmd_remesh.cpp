@@ -59,12 +59,14 @@ void add_remesh_command(CLI::App& app) {
     const RemeshResult result = remesh(input, options);
     nlohmann::json report = remesh_report(result, options);
     report["input"] = args->mesh;
-    // Everything is computed before anything is written; each file is written atomically.
-    ensure_writable_directory(args->out);
-    const std::filesystem::path dir(args->out);
+    // Everything is computed before anything is written, into a temporary folder renamed
+    // into place at the end: a failure or an interrupt leaves nothing under DIR.
+    AtomicDirectory out(args->out);
+    const std::filesystem::path dir(out.temp_path());
     for (int j = 0; j <= result.connectivity.levels(); ++j)
       write_mesh((dir / ("level_" + std::to_string(j) + ".vtp")).string(), result.mesh(j));
     write_text_file_atomically((dir / "report.json").string(), report.dump(2) + "\n");
+    out.commit();
     if (args->json) {
       print_json(report);
       return;

@@ -6,14 +6,14 @@ find_package(VTK REQUIRED COMPONENTS
   CommonCore CommonDataModel CommonExecutionModel CommonTransforms
   FiltersCore FiltersGeneral FiltersModeling FiltersSources FiltersGeometry
   ImagingCore IOGeometry IOLegacy IOPLY IOXML
-  RenderingCore RenderingOpenGL2 InteractionStyle IOImage)
+  RenderingCore RenderingOpenGL2 RenderingAnnotation InteractionStyle IOImage)
 # ITK bundles Eigen 3.3 under its include directory. Its include path must never reach a
 # translation unit that includes the system Eigen or CGAL, so ITK is only linked PRIVATE
 # into the small *_itk targets (see mrsnake_add_itk_library).
 find_package(ITK 5.2 REQUIRED COMPONENTS
   ITKCommon ITKIOImageBase ITKIONIFTI ITKIONRRD ITKIOMeta ITKIOGIPL ITKIOGDCM
   ITKImageIntensity ITKImageFilterBase ITKThresholding ITKSmoothing ITKImageGrid
-  ITKDistanceMap ITKLevelSets ITKImageGradient ITKRegistrationCommon ITKTransform
+  ITKBinaryMathematicalMorphology ITKLabelMap ITKDistanceMap ITKLevelSets ITKImageGradient ITKRegistrationCommon ITKTransform
   ITKImageFunction ITKStatistics ITKOptimizers ITKImageCompare)
 find_package(CLI11 CONFIG QUIET)
 find_package(nlohmann_json 3.10 REQUIRED)

@@ -27,6 +27,7 @@
 
 #include "mesh/atomic_file.h"
 #include "mesh/errors.h"
+#include "mesh/vtk_convert.h"
 
 namespace mrsnake {
 namespace {
@@ -37,45 +38,6 @@ void validate(const TriMesh& mesh, const std::string& path) {
     throw InputError("mesh '" + path + "' has NaN or infinite vertex coordinates; repair it first");
   if (mesh.F.minCoeff() < 0 || mesh.F.maxCoeff() >= mesh.num_vertices())
     throw InputError("mesh '" + path + "' has a face that references a missing vertex; the file is corrupt");
-}
-
-TriMesh from_polydata(vtkPolyData* input) {
-  vtkNew<vtkTriangleFilter> triangulate;
-  triangulate->SetInputData(input);
-  triangulate->PassVertsOff();
-  triangulate->PassLinesOff();
-  triangulate->Update();
-  vtkPolyData* poly = triangulate->GetOutput();
-  TriMesh mesh;
-  mesh.V.resize(poly->GetNumberOfPoints(), 3);
-  for (vtkIdType i = 0; i < poly->GetNumberOfPoints(); ++i) {
-    double p[3];
-    poly->GetPoint(i, p);
-    mesh.V.row(i) << p[0], p[1], p[2];
-  }
-  vtkCellArray* polys = poly->GetPolys();
-  mesh.F.resize(polys->GetNumberOfCells(), 3);
-  vtkNew<vtkIdList> ids;
-  polys->InitTraversal();
-  for (int f = 0; polys->GetNextCell(ids); ++f)
-    for (int k = 0; k < 3; ++k) mesh.F(f, k) = static_cast<int>(ids->GetId(k));
-  return mesh;
-}
-
-vtkSmartPointer<vtkPolyData> to_polydata(const TriMesh& mesh) {
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  points->SetNumberOfPoints(mesh.num_vertices());
-  for (int i = 0; i < mesh.num_vertices(); ++i) points->SetPoint(i, mesh.V(i, 0), mesh.V(i, 1), mesh.V(i, 2));
-  vtkNew<vtkCellArray> polys;
-  for (int f = 0; f < mesh.num_faces(); ++f) {
-    const vtkIdType ids[3] = {mesh.F(f, 0), mesh.F(f, 1), mesh.F(f, 2)};
-    polys->InsertNextCell(3, ids);
-  }
-  auto poly = vtkSmartPointer<vtkPolyData>::New();
-  poly->SetPoints(points);
-  poly->SetPolys(polys);
-  return poly;
 }
 
 // OFF has no VTK reader: a small, strict parser (comments, optional colour columns).

@@ -1,0 +1,197 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "mesh/errors.h"
+#include "mesh/image_io.h"
+#include "mesh/marching_cubes.h"
+#include "mesh/mesh_io.h"
+#include "mesh/primitives.h"
+#include "mesh/topology.h"
+#include "tests/test_support.h"
+
+using namespace mrsnake;
+
+namespace {
+
+/// A label volume with `label` on voxels whose physical centre lies within `radius` of
+/// `centre`; returns the number of such voxels in `count`.
+Volume voxelized_ball(const Volume& grid, const Eigen::Vector3d& centre, double radius, int label, std::size_t& count) {
+  Volume v = grid;
+  v.data.assign(v.num_voxels(), 0.0f);
+  count = 0;
+  for (std::size_t k = 0; k < v.size[2]; ++k)
+    for (std::size_t j = 0; j < v.size[1]; ++j)
+      for (std::size_t i = 0; i < v.size[0]; ++i) {
+        const auto p = v.index_to_physical(double(i), double(j), double(k));
+        if ((Eigen::Vector3d(p[0], p[1], p[2]) - centre).norm() <= radius) {
+          v.at(i, j, k) = static_cast<float>(label);
+          ++count;
+        }
+      }
+  return v;
+}
+
+Volume grid(std::size_t n, std::array<double, 3> spacing) {
+  Volume v;
+  v.size = {n, n, n};
+  v.spacing = spacing;
+  return v;
+}
+
+}  // namespace
+
+TEST(MarchingCubes, VoxelBallIsClosedGenusZeroWithTheLabelVolume) {
+  std::size_t count = 0;
+  const Volume labels = voxelized_ball(grid(48, {1, 1, 1}), {23.5, 23.5, 23.5}, 15.0, 7, count);
+  const LabelSurface s = extract_label_surface(labels, 7);
+  const auto topo = topology_report(s.mesh);
+  EXPECT_TRUE(topo.is_closed_genus0()) << topo.describe();
+  EXPECT_EQ(topo.inconsistently_oriented_edges, 0);
+  EXPECT_EQ(s.components_found, 1);
+  const double voxel_volume = static_cast<double>(count);
+  EXPECT_GT(enclosed_volume(s.mesh), 0.0) << "must be oriented outward";
+  EXPECT_NEAR(enclosed_volume(s.mesh) / voxel_volume, 1.0, 0.02);
+}
+
+TEST(MarchingCubes, SmoothingPreservesVolume) {
+  std::size_t count = 0;
+  const Volume labels = voxelized_ball(grid(40, {1, 1, 1}), {19.5, 19.5, 19.5}, 12.0, 1, count);
+  LabelSurfaceOptions options;
+  options.smoothing_iterations = 30;
+  const LabelSurface raw = extract_label_surface(labels, 1);
+  const LabelSurface smooth = extract_label_surface(labels, 1, options);
+  EXPECT_NEAR(enclosed_volume(smooth.mesh) / enclosed_volume(raw.mesh), 1.0, 0.02);
+  // Smoothing must actually move the staircase towards the sphere.
+  const auto radial_spread = [](const TriMesh& m) {
+    const Eigen::ArrayXd r = (m.V.rowwise() - Eigen::RowVector3d(19.5, 19.5, 19.5)).rowwise().norm().array();
+    return std::sqrt((r - r.mean()).square().mean());
+  };
+  EXPECT_LT(radial_spread(smooth.mesh), 0.6 * radial_spread(raw.mesh));
+}
+
+TEST(MarchingCubes, ObliqueAnisotropicGridGivesThePhysicalPlace) {
+  Volume g = grid(40, {0.7, 1.1, 1.6});
+  g.origin = {-12.0, 30.0, 5.5};
+  // A rotation of 30° about z then 20° about x: an oblique, proper direction matrix.
+  const Eigen::Matrix3d R =
+      (Eigen::AngleAxisd(0.35, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(0.52, Eigen::Vector3d::UnitZ())).toRotationMatrix();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) g.direction[3 * r + c] = R(r, c);
+  // The ball's centre: the physical point of the grid's middle.
+  const auto mid = g.index_to_physical(19.5, 19.5, 19.5);
+  const Eigen::Vector3d centre(mid[0], mid[1], mid[2]);
+  std::size_t count = 0;
+  const Volume labels = voxelized_ball(g, centre, 11.0, 1, count);
+  const LabelSurface s = extract_label_surface(labels, 1);
+  const Eigen::Vector3d mesh_centre = s.mesh.V.colwise().mean().transpose();
+  EXPECT_LT((mesh_centre - centre).norm(), 0.3);
+  const Eigen::ArrayXd r = (s.mesh.V.rowwise() - centre.transpose()).rowwise().norm().array();
+  EXPECT_NEAR(r.mean(), 11.0, 0.6);
+  EXPECT_NEAR(enclosed_volume(s.mesh) / (count * 0.7 * 1.1 * 1.6), 1.0, 0.03);
+
+  // A mirrored direction (det < 0) must still give an outward mesh at the same place.
+  Volume mirrored = labels;
+  for (int r = 0; r < 3; ++r) mirrored.direction[3 * r + 2] = -labels.direction[3 * r + 2];
+  const LabelSurface m = extract_label_surface(mirrored, 1);
+  EXPECT_GT(enclosed_volume(m.mesh), 0.0);
+  EXPECT_EQ(topology_report(m.mesh).inconsistently_oriented_edges, 0);
+}
+
+TEST(MarchingCubes, KeepsTheLargestComponentAndReportsTheOthers) {
+  std::size_t count = 0;
+  Volume labels = voxelized_ball(grid(40, {1, 1, 1}), {12, 12, 12}, 8.0, 1, count);
+  std::size_t small = 0;
+  const Volume second = voxelized_ball(labels, {30, 30, 30}, 4.0, 1, small);
+  for (std::size_t i = 0; i < labels.data.size(); ++i) labels.data[i] = std::max(labels.data[i], second.data[i]);
+  const LabelSurface s = extract_label_surface(labels, 1);
+  EXPECT_EQ(s.components_found, 2);
+  ASSERT_EQ(s.dropped_component_faces.size(), 1u);
+  EXPECT_TRUE(topology_report(s.mesh).is_closed_genus0());
+  EXPECT_LT((s.mesh.V.colwise().mean() - Eigen::RowVector3d(12, 12, 12)).norm(), 0.3);
+}
+
+TEST(MarchingCubes, ObjectTouchingTheBorderIsClosed) {
+  Volume labels = grid(10, {1, 1, 1});
+  labels.data.assign(labels.num_voxels(), 1.0f);  // the whole volume is the object
+  const LabelSurface s = extract_label_surface(labels, 1);
+  EXPECT_TRUE(topology_report(s.mesh).is_closed_genus0());
+}
+
+TEST(MarchingCubes, MissingLabelListsThePresentOnes) {
+  std::size_t count = 0;
+  const Volume labels = voxelized_ball(grid(16, {1, 1, 1}), {8, 8, 8}, 4.0, 3, count);
+  try {
+    extract_label_surface(labels, 5);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("labels present: 0, 3"), std::string::npos) << e.what();
+  }
+}
+
+TEST(MarchingCubes, IsosurfaceOfADistanceFieldIsTheSphere) {
+  Volume field = grid(32, {1, 1, 1});
+  field.data.resize(field.num_voxels());
+  for (std::size_t k = 0; k < 32; ++k)
+    for (std::size_t j = 0; j < 32; ++j)
+      for (std::size_t i = 0; i < 32; ++i)
+        field.at(i, j, k) = static_cast<float>(10.0 - Eigen::Vector3d(i - 15.5, j - 15.5, k - 15.5).norm());
+  const TriMesh s = extract_isosurface(field, 0.0);
+  const Eigen::ArrayXd r = (s.V.rowwise() - Eigen::RowVector3d(15.5, 15.5, 15.5)).rowwise().norm().array();
+  EXPECT_NEAR(r.minCoeff(), 10.0, 0.05);
+  EXPECT_NEAR(r.maxCoeff(), 10.0, 0.05);
+  EXPECT_NEAR(enclosed_volume(s) / (4.0 / 3.0 * M_PI * 1000.0), 1.0, 0.01);
+}
+
+TEST(McCommand, WritesAMeshAndRefusesAnAbsentLabel) {
+  const auto dir = test::scratch_dir("mc-cli");
+  std::size_t count = 0;
+  const Volume labels = voxelized_ball(grid(24, {1, 1, 2}), {11.5, 11.5, 23}, 7.0, 2, count);
+  const std::string img = (dir / "labels.nii.gz").string();
+  write_volume(img, labels, VoxelType::uint8);
+  auto r = test::run_mrsnake("mc --labels " + img + " --label 2 -o " + (dir / "s.vtp").string() + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(topology_report(read_mesh((dir / "s.vtp").string())).is_closed_genus0());
+  r = test::run_mrsnake("mc --labels " + img + " --label 9 -o " + (dir / "t.vtp").string());
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("not present"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "t.vtp"));
+  r = test::run_mrsnake("mc --labels " + (dir / "nope.nii.gz").string() + " --label 1 -o " + (dir / "u.vtp").string());
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+}
+
+TEST(McCommand, LiverIsOneClosedGenusZeroSurface) {
+  MRSNAKE_REQUIRE_DATA(liver, "volumes/liver-labels.nii.gz");
+  const Volume labels = read_volume(liver);
+  const LabelSurface s = extract_label_surface(labels, 255);
+  const auto topo = topology_report(s.mesh);
+  EXPECT_TRUE(topo.is_closed_genus0()) << topo.describe();
+  EXPECT_GT(s.mesh.num_faces(), 10000);
+}
+
+TEST(MarchingCubes, ClosingRepairsATunnelOnlyWhenAsked) {
+  // A torus (major radius 9, minor 5.5): its hole has radius 3.5 voxels.
+  Volume labels = grid(40, {1, 1, 1});
+  labels.data.assign(labels.num_voxels(), 0.f);
+  for (std::size_t k = 0; k < 40; ++k)
+    for (std::size_t j = 0; j < 40; ++j)
+      for (std::size_t i = 0; i < 40; ++i) {
+        const double x = i - 19.5, y = j - 19.5, z = k - 19.5;
+        const double ring = std::hypot(x, y) - 9.0;
+        if (ring * ring + z * z <= 5.5 * 5.5) labels.at(i, j, k) = 4.f;
+      }
+  const LabelSurface plain = extract_label_surface(labels, 4);
+  EXPECT_EQ(topology_report(plain.mesh).genus, 1);
+  EXPECT_EQ(plain.closing_radius, 0);
+
+  LabelSurfaceOptions options;
+  options.max_closing_radius = 6;
+  const LabelSurface repaired = extract_label_surface(labels, 4, options);
+  EXPECT_TRUE(topology_report(repaired.mesh).is_closed_genus0());
+  EXPECT_EQ(repaired.genus_before_repair, 1);
+  EXPECT_GE(repaired.closing_radius, 1);
+  EXPECT_LE(repaired.closing_radius, 6);
+  // The repair fills the hole but keeps the outside: the volume only grows, and not by much.
+  EXPECT_GT(enclosed_volume(repaired.mesh), enclosed_volume(plain.mesh));
+  EXPECT_LT(enclosed_volume(repaired.mesh), 1.3 * enclosed_volume(plain.mesh));
+}
