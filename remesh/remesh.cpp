@@ -2,8 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
+#include <memory>
 #include <cmath>
 #include <stdexcept>
 
@@ -16,6 +15,8 @@
 #include "remesh/lloyd.h"
 #include "remesh/parameterization.h"
 #include "remesh/shape_smoothing.h"
+#include "remesh/simplify.h"
+#include "mesh/topology.h"
 
 namespace mrsnake {
 namespace {
@@ -59,13 +60,34 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   if (input.empty()) throw InputError("the mesh has no faces");
 
   RemeshResult result;
-  report(options.progress, "parameterize", 0);
-  const Parameterization param = parameterize(input);
-  result.domain = param.kind == DomainKind::sphere ? "sphere" : "disk";
-  result.parameterization = param.summary;
-
+  const TriMesh original = remove_unreferenced_vertices(input);
+  require_disk_or_sphere(topology_report(original), "the input surface");
   int levels = options.levels, n0 = options.base_vertices;
   if (levels == 0) choose_resolution(options.target_faces, levels, n0);
+
+  // A much finer input is simplified before the (costly) parameterization.
+  TriMesh work = original;
+  std::unique_ptr<SurfaceLocator> reproject;
+  const auto simplify_start = Clock::now();
+  const double finest_faces = 2.0 * n0 * std::pow(4.0, levels);
+  const double limit = std::max<double>(options.simplify_above_faces, 8 * finest_faces);
+  if (options.simplify_above_faces > 0 && original.num_faces() > limit) {
+    report(options.progress, "simplify", 0);
+    TriMesh simplified = simplify_to_faces(original, static_cast<int>(limit));
+    const TopologyReport before = topology_report(original), after = topology_report(simplified);
+    if (after.is_disk() == before.is_disk() && after.is_closed_genus0() == before.is_closed_genus0()) {
+      work = std::move(simplified);
+      reproject = std::make_unique<SurfaceLocator>(original);
+    }
+  }
+
+  report(options.progress, "parameterize", 0);
+  const Parameterization param = parameterize(work);
+  result.domain = param.kind == DomainKind::sphere ? "sphere" : "disk";
+  result.parameterization = param.summary;
+  result.parameterization["input_faces"] = original.num_faces();
+  result.parameterization["parameterized_faces"] = work.num_faces();
+  result.parameterization["seconds"] = seconds_since(simplify_start);  // simplification included
 
   const auto base_start = Clock::now();
   report(options.progress, "base mesh", 0);
@@ -76,14 +98,6 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   result.parameterization["base_faces"] = base.faces.rows();
   result.parameterization["base_valence_flips"] = base.valence_flips;
 
-  if (std::getenv("MRSNAKE_REMESH_DEBUG")) {
-    std::vector<int> val(n0, 0);
-    for (int f = 0; f < base.faces.rows(); ++f)
-      for (int k = 0; k < 3; ++k) ++val[base.faces(f, k)];
-    const auto bd = boundary_vertices(base.faces, n0);
-    for (int v = 0; v < n0; ++v) std::fprintf(stderr, "%s%d ", bd[v] ? "b" : "", val[v] + (bd[v] ? 1 : 0));
-    std::fprintf(stderr, "\n");
-  }
   const DomainMesh domain_mesh(param.domain, param.surface.F);
   DensityField density{&domain_mesh, param.vertex_stretch.array().pow(options.density_exponent).matrix()};
   const DomainKind kind = param.kind;
@@ -126,6 +140,9 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       shape.iterations = options.shape_iterations;
       shape_moves = smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, shape);
     }
+    if (reproject)
+      for (int v = 0; v < level.positions.rows(); ++v)
+        level.positions.row(v) = reproject->closest(level.positions.row(v).transpose()).point.transpose();
     const int flipped = count_flipped(U, F);
     if (flipped > 0)
       throw AlgorithmError("level " + std::to_string(j) + " has " + std::to_string(flipped) +
@@ -146,28 +163,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     if (options.compute_stats) {
       const TriMesh mesh{level.positions, F};
       s["quality"] = mesh_quality(mesh);
-      s["distance"] = surface_distance(mesh, param.surface);
-    }
-    if (std::getenv("MRSNAKE_REMESH_DEBUG") && j == levels) {
-      const TriMesh mesh{level.positions, F};
-      std::vector<int> valence(U.rows(), 0);
-      for (int f = 0; f < F.rows(); ++f)
-        for (int k = 0; k < 3; ++k) ++valence[F(f, k)];
-      std::vector<std::pair<double, int>> q;
-      for (int f = 0; f < F.rows(); ++f)
-        q.push_back({frey_borouchaki_quality(mesh.V.row(F(f, 0)), mesh.V.row(F(f, 1)), mesh.V.row(F(f, 2))), f});
-      std::sort(q.begin(), q.end());
-      for (int i = 0; i < 15; ++i) {
-        const int f = q[i].second;
-        std::fprintf(stderr, "Q %.3f face %d:", q[i].first, f);
-        for (int k = 0; k < 3; ++k) {
-          const int v = F(f, k);
-          const int pf = hints[v];
-          std::fprintf(stderr, " v%d(lvl %d val %d stretch %.3g x %.3f %.3f %.3f)", v, result.connectivity.level_of_vertex(v), valence[v],
-                       param.face_stretch[pf], mesh.V(v, 0), mesh.V(v, 1), mesh.V(v, 2));
-        }
-        std::fprintf(stderr, "\n");
-      }
+      s["distance"] = surface_distance(mesh, original);
     }
     result.levels.push_back(std::move(level));
     report(options.progress, "level " + std::to_string(j), 1.0);

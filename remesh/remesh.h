@@ -44,6 +44,10 @@ struct RemeshOptions {
   /// triangles, moved in D (remesh/shape_smoothing.h). The Lloyd step evens out sizes but is
   /// affine invariant, so it cannot repair shear; this can. 0 = the Lloyd step alone.
   int shape_iterations = 3;
+  /// Inputs with more faces than max(simplify_above_faces, 8 x the finest level's faces) are
+  /// simplified to that size before parameterization (remesh/simplify.h); the result is then
+  /// projected back onto the original input. 0 = never simplify.
+  int simplify_above_faces = 100000;
   /// Compute quality and distance per level into RemeshLevel::stats (costs time).
   bool compute_stats = true;
   ProgressFn progress;

@@ -114,6 +114,16 @@ TEST(Remesh, EllipsoidNestsExactlyWithoutFlipsInEveryMode) {
   }
 }
 
+TEST(Remesh, FineInputIsSimplifiedThenProjectedBackOntoIt) {
+  const TriMesh input = ellipsoid(5);  // 20480 faces
+  RemeshOptions o = small_options(2, 20);
+  o.simplify_above_faces = 2000;
+  const RemeshResult r = remesh(input, o);
+  EXPECT_LT(r.parameterization["parameterized_faces"].get<int>(), input.num_faces());
+  EXPECT_GE(r.parameterization["parameterized_faces"].get<int>(), 2000);
+  expect_nested_and_valid(r, input, true);  // includes: every vertex lies on the original input
+}
+
 TEST(Remesh, StrictModeKeepsCoarseVerticesInTheDomain) {
   const RemeshResult r = remesh(ellipsoid(3), small_options(2, 16, RelaxMode::new_vertices_only));
   for (int j = 1; j <= 2; ++j) {
