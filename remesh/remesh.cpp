@@ -125,21 +125,36 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       }
     }
     LloydStats relax_stats;
-    const bool relax = options.relax == RelaxMode::all_vertices ||
-                       (options.relax == RelaxMode::new_vertices_only && j > 0);
-    if (relax) {
-      lloyd.first_movable = options.relax == RelaxMode::new_vertices_only ? result.connectivity.vertex_count(j - 1) : 0;
-      relax_stats = constrained_lloyd(kind, F, density, U, hints, lloyd);
-    }
-    report(options.progress, "level " + std::to_string(j), 0.5);
     RemeshLevel level;
-    level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
     int shape_moves = 0;
     if (options.relax == RelaxMode::all_vertices && options.shape_iterations > 0) {
+      // Lloyd (sizes) and shape smoothing (angles) pull against each other; interleaving
+      // them in rounds balances the two better than running one after the other.
+      const int rounds = options.shape_iterations;
       ShapeSmoothingOptions shape;
-      shape.iterations = options.shape_iterations;
-      shape_moves = smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, shape);
+      shape.iterations = 1;
+      lloyd.first_movable = 0;
+      for (int round = 0; round < rounds; ++round) {
+        lloyd.iterations = options.lloyd_iterations * (round + 1) / rounds - options.lloyd_iterations * round / rounds;
+        const LloydStats s = constrained_lloyd(kind, F, density, U, hints, lloyd);
+        relax_stats.moves += s.moves;
+        relax_stats.shortened_moves += s.shortened_moves;
+        relax_stats.rejected_moves += s.rejected_moves;
+        relax_stats.mean_shift = s.mean_shift;
+        level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
+        shape_moves += smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, shape);
+      }
+    } else {
+      const bool relax = options.relax == RelaxMode::all_vertices ||
+                         (options.relax == RelaxMode::new_vertices_only && j > 0);
+      if (relax) {
+        lloyd.iterations = options.lloyd_iterations;
+        lloyd.first_movable = options.relax == RelaxMode::new_vertices_only ? result.connectivity.vertex_count(j - 1) : 0;
+        relax_stats = constrained_lloyd(kind, F, density, U, hints, lloyd);
+      }
+      level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
     }
+    report(options.progress, "level " + std::to_string(j), 0.5);
     if (reproject)
       for (int v = 0; v < level.positions.rows(); ++v)
         level.positions.row(v) = reproject->closest(level.positions.row(v).transpose()).point.transpose();
