@@ -18,7 +18,7 @@ void add_remesh_command(CLI::App& app) {
   struct Args {
     std::string mesh, out;
     int levels = 0, faces = 16000, base_vertices = 32, iterations = 8, shape_iterations = 3;
-    double exponent = 2.0;
+    double exponent = 2.0, curvature = 1.0;
     bool no_relax = false, strict = false, json = false;
   };
   auto args = std::make_shared<Args>();
@@ -39,6 +39,8 @@ void add_remesh_command(CLI::App& app) {
   no_relax->excludes(strict);
   cmd->add_option("--density-exponent", args->exponent, "Lloyd density = stretch^e (default 2: even 3D spacing)")
       ->check(CLI::Range(0.0, 8.0));
+  cmd->add_option("--curvature-weight", args->curvature, "Denser where the surface bends: 3D density 1 + w·κ/mean κ (default 1; 0 = even spacing)")
+      ->check(CLI::Range(0.0, 100.0));
   cmd->add_option("--iterations", args->iterations, "Lloyd iterations per level (default 8)")->check(CLI::Range(0, 1000));
   cmd->add_option("--shape-iterations", args->shape_iterations,
                   "Iterations per level of 3D shape smoothing after Lloyd (default 3; not with --strict or --no-relax)")
@@ -54,6 +56,7 @@ void add_remesh_command(CLI::App& app) {
     options.lloyd_iterations = args->iterations;
     options.density_exponent = args->exponent;
     options.shape_iterations = args->shape_iterations;
+    options.curvature_weight = args->curvature;
     options.relax = args->no_relax ? RelaxMode::none : args->strict ? RelaxMode::new_vertices_only : RelaxMode::all_vertices;
     if (!global_options().quiet) options.progress = terminal_progress();
     const RemeshResult result = remesh(input, options);

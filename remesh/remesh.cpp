@@ -16,6 +16,7 @@
 #include "remesh/parameterization.h"
 #include "remesh/shape_smoothing.h"
 #include "remesh/simplify.h"
+#include "remesh/sizing.h"
 #include "mesh/topology.h"
 
 namespace mrsnake {
@@ -99,7 +100,16 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   result.parameterization["base_valence_flips"] = base.valence_flips;
 
   const DomainMesh domain_mesh(param.domain, param.surface.F);
-  DensityField density{&domain_mesh, param.vertex_stretch.array().pow(options.density_exponent).matrix()};
+  Eigen::VectorXd wanted = Eigen::VectorXd::Ones(param.surface.num_vertices());  // wanted 3D point density
+  if (options.curvature_weight > 0) {
+    const Eigen::VectorXd kappa = vertex_curvature(param.surface, 8);
+    const double mean = kappa.mean();
+    // Capped, so that a few sharp spots (voxel steps of a marching-cubes surface) cannot pull
+    // the spacing down so fast that triangle shapes suffer.
+    if (mean > 0) wanted.array() += options.curvature_weight * (kappa.array() / mean).min(3.0);
+  }
+  DensityField density{&domain_mesh,
+                       param.vertex_stretch.cwiseProduct(wanted).array().pow(options.density_exponent).matrix()};
   const DomainKind kind = param.kind;
 
   RowMatrixX3d U = base.domain;
@@ -192,6 +202,7 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["levels"] = result.connectivity.levels();
   j["relax"] = relax_name(options.relax);
   j["density_exponent"] = options.density_exponent;
+  j["curvature_weight"] = options.curvature_weight;
   j["lloyd_iterations"] = options.lloyd_iterations;
   j["shape_iterations"] = options.relax == RelaxMode::all_vertices ? options.shape_iterations : 0;
   j["parameterization"] = result.parameterization;

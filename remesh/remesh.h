@@ -38,6 +38,9 @@ struct RemeshOptions {
   /// The Lloyd density is stretch^density_exponent, stretch = A3D/A_D. 2 makes the 3D
   /// spacing even (2D Lloyd spaces points as density^(-1/4)).
   double density_exponent = 2.0;
+  /// Curvature sizing: the wanted 3D point density is w = 1 + curvature_weight·κ/mean(κ)
+  /// (remesh/sizing.h) and the Lloyd density (stretch·w)^density_exponent. 0 = even 3D spacing.
+  double curvature_weight = 1.0;
   /// Lloyd iterations per level (level 0 included unless relax == new_vertices_only).
   int lloyd_iterations = 8;
   /// With all_vertices: iterations per level of tangential smoothing toward equilateral 3D
