@@ -61,22 +61,24 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   if (input.empty()) throw InputError("the mesh has no faces");
 
   RemeshResult result;
+  const auto simplify_start = Clock::now();
   const TriMesh original = remove_unreferenced_vertices(input);
-  require_disk_or_sphere(topology_report(original), "the input surface");
+  const TopologyReport topology = topology_report(original);
+  require_disk_or_sphere(topology, "the input surface");
   int levels = options.levels, n0 = options.base_vertices;
   if (levels == 0) choose_resolution(options.target_faces, levels, n0);
 
   // A much finer input is simplified before the (costly) parameterization.
   TriMesh work = original;
   std::unique_ptr<SurfaceLocator> reproject;
-  const auto simplify_start = Clock::now();
   const double finest_faces = 2.0 * n0 * std::pow(4.0, levels);
   const double limit = std::max<double>(options.simplify_above_faces, 8 * finest_faces);
   if (options.simplify_above_faces > 0 && original.num_faces() > limit) {
     report(options.progress, "simplify", 0);
     TriMesh simplified = simplify_to_faces(original, static_cast<int>(limit));
-    const TopologyReport before = topology_report(original), after = topology_report(simplified);
-    if (after.is_disk() == before.is_disk() && after.is_closed_genus0() == before.is_closed_genus0()) {
+    result.parameterization["simplify_seconds"] = seconds_since(simplify_start);
+    const TopologyReport after = topology_report(simplified);
+    if (after.is_disk() == topology.is_disk() && after.is_closed_genus0() == topology.is_closed_genus0()) {
       work = std::move(simplified);
       reproject = std::make_unique<SurfaceLocator>(original);
     }
@@ -85,10 +87,12 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   report(options.progress, "parameterize", 0);
   const Parameterization param = parameterize(work);
   result.domain = param.kind == DomainKind::sphere ? "sphere" : "disk";
+  const nlohmann::json simplify_info = result.parameterization;
   result.parameterization = param.summary;
+  result.parameterization.update(simplify_info);
   result.parameterization["input_faces"] = original.num_faces();
   result.parameterization["parameterized_faces"] = work.num_faces();
-  result.parameterization["seconds"] = seconds_since(simplify_start);  // simplification included
+  result.parameterization["seconds"] = seconds_since(simplify_start);  // input checks and simplification included
 
   const auto base_start = Clock::now();
   report(options.progress, "base mesh", 0);

@@ -18,6 +18,7 @@
 #include "remesh/lloyd.h"
 #include "remesh/parameterization.h"
 #include "remesh/remesh.h"
+#include "remesh/sizing.h"
 #include "tests/test_support.h"
 
 namespace mrsnake {
@@ -214,6 +215,20 @@ TEST(Remesh, MobiusMapKeepsTheSphereAndCentresThePoint) {
                           r = mobius_to_center(a, s.V.row(s.F(f, 2)));
     EXPECT_GT(domain_orientation(p, q, r), 0);
   }
+}
+
+TEST(Sizing, CurvatureOfASphereIsOneOverItsRadius) {
+  const TriMesh sphere = icosphere(4, 2.0);
+  const Eigen::VectorXd kappa = vertex_curvature(sphere);
+  EXPECT_NEAR(kappa.minCoeff(), 0.5, 0.03);
+  EXPECT_NEAR(kappa.maxCoeff(), 0.5, 0.03);
+  // A flatter ellipsoid bends most at the ends of its long axis.
+  const TriMesh e = ellipsoid(4);
+  const Eigen::VectorXd k = vertex_curvature(e);
+  int tip = 0, side = 0;
+  e.V.col(0).maxCoeff(&tip);
+  e.V.col(2).maxCoeff(&side);
+  EXPECT_GT(k[tip], 2 * k[side]);
 }
 
 // The paper's Fig. 1: a vertex with a non-convex 1-ring. Its Voronoi cell pokes out of the
