@@ -89,7 +89,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   result.domain = param.kind == DomainKind::sphere ? "sphere" : "disk";
   const nlohmann::json simplify_info = result.parameterization;
   result.parameterization = param.summary;
-  result.parameterization.update(simplify_info);
+  if (simplify_info.is_object()) result.parameterization.update(simplify_info);
   result.parameterization["input_faces"] = original.num_faces();
   result.parameterization["parameterized_faces"] = work.num_faces();
   result.parameterization["seconds"] = seconds_since(simplify_start);  // input checks and simplification included
