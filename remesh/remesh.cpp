@@ -192,7 +192,13 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     if (options.compute_stats) {
       const TriMesh mesh{level.positions, F};
       s["quality"] = mesh_quality(mesh);
-      s["distance"] = surface_distance(mesh, original);
+      // Metro-style sampling of both surfaces, capped at ~500k samples per surface: a
+      // marching-cubes input has hundreds of thousands of faces.
+      DistanceOptions sampling;
+      sampling.samples_per_face =
+          std::clamp(static_cast<int>(5e5 / std::max(original.num_faces(), mesh.num_faces())), 1, 10);
+      s["distance"] = surface_distance(mesh, original, sampling);
+      s["distance"]["samples_per_face"] = sampling.samples_per_face;
     }
     result.levels.push_back(std::move(level));
     report(options.progress, "level " + std::to_string(j), 1.0);
