@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
 
   cli::add_info_command(app);
   cli::add_mc_command(app);
+  cli::add_quality_command(app);
 
   try {
     app.parse(argc, argv);

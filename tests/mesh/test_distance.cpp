@@ -1,0 +1,163 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "mesh/distance.h"
+#include "mesh/errors.h"
+#include "mesh/primitives.h"
+
+using namespace mrsnake;
+
+namespace {
+
+TriMesh unit_right_triangle() {
+  TriMesh m;
+  m.V.resize(3, 3);
+  m.V << 0, 0, 0, 1, 0, 0, 0, 1, 0;
+  m.F.resize(1, 3);
+  m.F << 0, 1, 2;
+  return m;
+}
+
+TriMesh merged(const TriMesh& a, const TriMesh& b) {
+  TriMesh m;
+  m.V.resize(a.V.rows() + b.V.rows(), 3);
+  m.V << a.V, b.V;
+  m.F.resize(a.F.rows() + b.F.rows(), 3);
+  m.F << a.F, (b.F.array() + a.num_vertices()).matrix();
+  return m;
+}
+
+/// Sag of a sphere mesh whose vertices lie on radius R: R minus the smallest distance from
+/// the centre to any point of a face (for these near-equilateral faces, the foot of the
+/// perpendicular from the centre lies inside the face, so it is the plane distance).
+double max_sag(const TriMesh& m, double radius) {
+  double sag = 0;
+  for (int f = 0; f < m.num_faces(); ++f) {
+    const Eigen::Vector3d a = m.V.row(m.F(f, 0)), b = m.V.row(m.F(f, 1)), c = m.V.row(m.F(f, 2));
+    const Eigen::Vector3d n = (b - a).cross(c - a).normalized();
+    sag = std::max(sag, radius - std::abs(n.dot(a)));
+  }
+  return sag;
+}
+
+}  // namespace
+
+TEST(SurfaceLocator, ClosestPointOnKnownTriangle) {
+  const SurfaceLocator locator(unit_right_triangle());
+  // Above the interior: the foot of the perpendicular.
+  auto hit = locator.closest({0.2, 0.3, 5.0});
+  EXPECT_EQ(hit.face, 0);
+  EXPECT_NEAR((hit.point - Eigen::Vector3d(0.2, 0.3, 0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR(hit.distance, 5.0, 1e-12);
+  EXPECT_NEAR((hit.barycentric - Eigen::Vector3d(0.5, 0.2, 0.3)).norm(), 0.0, 1e-12);
+  // Beyond the hypotenuse x + y = 1: its midpoint.
+  hit = locator.closest({2.0, 2.0, 1.0});
+  EXPECT_NEAR((hit.point - Eigen::Vector3d(0.5, 0.5, 0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR(hit.distance, std::sqrt(1.5 * 1.5 * 2 + 1.0), 1e-12);
+  EXPECT_NEAR((hit.barycentric - Eigen::Vector3d(0.0, 0.5, 0.5)).norm(), 0.0, 1e-12);
+  // Behind the right-angle corner: the corner itself.
+  hit = locator.closest({-1.0, -2.0, 0.0});
+  EXPECT_NEAR(hit.point.norm(), 0.0, 1e-12);
+  EXPECT_NEAR(hit.distance, std::sqrt(5.0), 1e-12);
+  EXPECT_NEAR((hit.barycentric - Eigen::Vector3d(1, 0, 0)).norm(), 0.0, 1e-12);
+
+  RowMatrixX3d P(2, 3);
+  P << 0.2, 0.3, -2.0, 1.0, 0.0, 3.0;
+  const Eigen::VectorXd d = locator.distances(P);
+  EXPECT_NEAR(d[0], 2.0, 1e-12);
+  EXPECT_NEAR(d[1], 3.0, 1e-12);
+}
+
+TEST(SurfaceLocator, FindsTheRightFaceOnASphere) {
+  const TriMesh sphere = icosphere(3, 2.0);
+  const SurfaceLocator locator(sphere);
+  for (int f = 0; f < sphere.num_faces(); f += 37) {
+    const Eigen::Vector3d centroid =
+        (sphere.V.row(sphere.F(f, 0)) + sphere.V.row(sphere.F(f, 1)) + sphere.V.row(sphere.F(f, 2))) / 3.0;
+    // Pushed outward along the radius, the centroid still projects onto its own face.
+    const auto hit = locator.closest(centroid * 1.05);
+    EXPECT_EQ(hit.face, f);
+    EXPECT_NEAR((hit.barycentric - Eigen::Vector3d::Constant(1.0 / 3.0)).norm(), 0.0, 0.02);
+    const Eigen::Vector3d rebuilt = hit.barycentric[0] * sphere.V.row(sphere.F(f, 0)).transpose() +
+                                    hit.barycentric[1] * sphere.V.row(sphere.F(f, 1)).transpose() +
+                                    hit.barycentric[2] * sphere.V.row(sphere.F(f, 2)).transpose();
+    EXPECT_NEAR((rebuilt - hit.point).norm(), 0.0, 1e-12);
+  }
+}
+
+TEST(SurfaceDistance, MeshAgainstItselfIsZero) {
+  const TriMesh sphere = icosphere(3, 4.0);
+  const SurfaceDistance d = surface_distance(sphere, sphere);
+  EXPECT_LT(d.hausdorff_mm, 1e-9);
+  EXPECT_LT(d.rms_mm, 1e-9);
+  EXPECT_GT(d.reference_diagonal_mm, 8.0);
+}
+
+TEST(SurfaceDistance, ConcentricSpheresAreTheRadiusDifferenceApart) {
+  // Vertices of both meshes lie on spheres of radius R = 10 and 1.01·R; faces are chords
+  // that dip at most s (sag, ≈ 0.002 mm at level 5) inside their sphere, 1.01·s for the
+  // larger. A point of the small mesh has |x| ∈ [R − s, R], so its distance to the large
+  // mesh (which lies in the shell [1.01R − 1.01s, 1.01R]) is in [0.1 − 1.01s, 0.1 + s];
+  // the same bound holds the other way. So mean, RMS and Hausdorff all lie in
+  // [0.1 − 1.01s, 0.1 + 1.01s] mm.
+  const double R = 10.0;
+  const TriMesh small = icosphere(5, R);
+  TriMesh large = small;
+  large.V *= 1.01;
+  const double s = max_sag(small, R);
+  EXPECT_LT(s, 0.005);
+  const double lo = 0.1 - 1.01 * s - 1e-12, hi = 0.1 + 1.01 * s + 1e-12;
+  DistanceOptions options;
+  options.samples_per_face = 2;
+  const SurfaceDistance d = surface_distance(small, large, options);
+  EXPECT_GE(d.mean_mm, lo);
+  EXPECT_LE(d.mean_mm, hi);
+  EXPECT_GE(d.rms_mm, lo);
+  EXPECT_LE(d.rms_mm, hi);
+  EXPECT_GE(d.hausdorff_mm, lo);
+  EXPECT_LE(d.hausdorff_mm, hi);
+  EXPECT_NEAR(d.hausdorff_mm, 0.1, 0.005);
+  EXPECT_NEAR(d.reference_diagonal_mm, bounding_box_diagonal(large.V), 1e-12);
+  EXPECT_NEAR(d.rms_pct, 100.0 * d.rms_mm / d.reference_diagonal_mm, 1e-12);
+  EXPECT_NEAR(d.hausdorff_pct, 100.0 * d.hausdorff_mm / d.reference_diagonal_mm, 1e-12);
+}
+
+TEST(SurfaceDistance, DeterministicFromTheSeedAndSensitiveToAFarVertex) {
+  const TriMesh a = icosphere(2, 1.0);
+  TriMesh b = icosphere(2, 1.0);
+  b.V.row(0) *= 1.5;  // one vertex pulled out by 0.5
+  DistanceOptions options;
+  options.seed = 7;
+  const SurfaceDistance d1 = surface_distance(b, a, options), d2 = surface_distance(b, a, options);
+  EXPECT_EQ(d1.rms_mm, d2.rms_mm);
+  EXPECT_EQ(d1.hausdorff_mm, d2.hausdorff_mm);
+  // The pulled vertex is 0.5 from the unit sphere and farther than 0.45 from any flat face of a.
+  EXPECT_GT(d1.hausdorff_mm, 0.45);
+  EXPECT_LE(d1.hausdorff_mm, 0.5 + 1e-12);
+  options.seed = 8;
+  EXPECT_NE(surface_distance(b, a, options).rms_mm, d1.rms_mm);
+  EXPECT_THROW(surface_distance(TriMesh{}, a), InputError);
+
+  const nlohmann::json j = d1;
+  for (const char* key : {"mean_mm", "rms_mm", "hausdorff_mm", "mean_pct", "rms_pct", "hausdorff_pct",
+                          "reference_diagonal_mm"})
+    EXPECT_TRUE(j.contains(key)) << key;
+}
+
+TEST(SelfIntersections, NoneOnASphereSomeOnTwoInterpenetratingSpheres) {
+  const TriMesh sphere = icosphere(3, 1.0);
+  EXPECT_EQ(count_self_intersections(sphere), 0);
+
+  TriMesh apart = icosphere(3, 1.0);
+  apart.V.col(0).array() += 3.0;
+  EXPECT_EQ(count_self_intersections(merged(sphere, apart)), 0);
+
+  TriMesh overlapping = icosphere(3, 1.0);
+  overlapping.V.col(0).array() += 1.0;  // centres 1 apart, radii 1: they cross on a circle
+  const int pairs = count_self_intersections(merged(sphere, overlapping));
+  // The circle of intersection (radius √3/2) crosses many faces of both spheres.
+  EXPECT_GT(pairs, 20);
+}
