@@ -4,12 +4,14 @@
 #include <iostream>
 
 #include "apps/cli.h"
+#include "mesh/atomic_file.h"
 #include "mesh/errors.h"
 
 int main(int argc, char** argv) {
   using namespace mrsnake;
   // VTK would print its own multi-line errors for bad files; mrsnake reports them itself.
   vtkObject::GlobalWarningDisplayOff();
+  install_interrupt_cleanup();
 
   CLI::App app{"mrsnake: fast 3D organ segmentation with a multiresolution snake and a prior shape model", "mrsnake"};
   app.set_version_flag("--version", std::string("mrsnake ") + MRSNAKE_VERSION);
@@ -19,8 +21,8 @@ int main(int argc, char** argv) {
   app.footer("Run 'mrsnake <command> --help' for a command's options and an example.");
 
   cli::add_info_command(app);
-  cli::add_mc_command(app);
   cli::add_quality_command(app);
+  cli::add_mc_command(app);
 
   try {
     app.parse(argc, argv);

@@ -1,16 +1,95 @@
 #include "mesh/atomic_file.h"
 
+#include <dirent.h>
+#include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
+#include <set>
 
 #include "mesh/errors.h"
 
 namespace fs = std::filesystem;
 
 namespace mrsnake {
+namespace {
+
+// Live temporaries, removed by the interrupt handler. Kept as a fixed table of C strings so
+// the handler does not allocate.
+constexpr int kMaxLive = 64;
+constexpr int kMaxPath = 4096;
+char g_live[kMaxLive][kMaxPath];
+volatile sig_atomic_t g_used[kMaxLive];
+std::mutex g_live_mutex;
+
+int register_temp(const std::string& path) {
+  std::lock_guard<std::mutex> lock(g_live_mutex);
+  if (path.size() >= kMaxPath) return -1;
+  for (int i = 0; i < kMaxLive; ++i)
+    if (!g_used[i]) {
+      std::memcpy(g_live[i], path.c_str(), path.size() + 1);
+      g_used[i] = 1;
+      return i;
+    }
+  return -1;
+}
+
+void unregister_temp(int slot) {
+  if (slot < 0) return;
+  std::lock_guard<std::mutex> lock(g_live_mutex);
+  g_used[slot] = 0;
+}
+
+// Removes a file or a folder tree with plain system calls (usable from a signal handler).
+void remove_tree(const char* path) {
+  struct stat st;
+  if (lstat(path, &st) != 0) return;
+  if (S_ISDIR(st.st_mode)) {
+    if (DIR* dir = opendir(path)) {
+      while (dirent* e = readdir(dir)) {
+        if (!std::strcmp(e->d_name, ".") || !std::strcmp(e->d_name, "..")) continue;
+        char child[kMaxPath];
+        const int n = snprintf(child, sizeof child, "%s/%s", path, e->d_name);
+        if (n > 0 && n < kMaxPath) remove_tree(child);
+      }
+      closedir(dir);
+    }
+    rmdir(path);
+  } else {
+    unlink(path);
+  }
+}
+
+extern "C" void on_interrupt(int sig) {
+  for (int i = 0; i < kMaxLive; ++i)
+    if (g_used[i]) remove_tree(g_live[i]);
+  const char msg[] = "\nmrsnake: interrupted; partial outputs removed\n";
+  [[maybe_unused]] auto ignored = write(STDERR_FILENO, msg, sizeof msg - 1);
+  _exit(128 + sig);
+}
+
+std::string temp_name_beside(const std::string& final_path) {
+  static std::atomic<int> counter{0};
+  const fs::path p(final_path);
+  return (p.parent_path() / (".tmp-" + std::to_string(getpid()) + "-" + std::to_string(counter++) + "-" +
+                             p.filename().string()))
+      .string();
+}
+
+}  // namespace
+
+void install_interrupt_cleanup() {
+  struct sigaction sa {};
+  sa.sa_handler = on_interrupt;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
 
 void ensure_writable_directory(const std::string& dir) {
   std::error_code ec;
@@ -22,12 +101,9 @@ void ensure_writable_directory(const std::string& dir) {
 }
 
 AtomicOutput::AtomicOutput(std::string final_path) : final_(std::move(final_path)) {
-  static std::atomic<int> counter{0};
-  const fs::path p(final_);
-  ensure_writable_directory(p.parent_path().string());
-  const std::string name = ".tmp-" + std::to_string(getpid()) + "-" + std::to_string(counter++) + "-" +
-                           p.filename().string();
-  temp_ = (p.parent_path() / name).string();
+  ensure_writable_directory(fs::path(final_).parent_path().string());
+  temp_ = temp_name_beside(final_);
+  slot_ = register_temp(temp_);
 }
 
 AtomicOutput::~AtomicOutput() {
@@ -35,6 +111,7 @@ AtomicOutput::~AtomicOutput() {
     std::error_code ec;
     fs::remove(temp_, ec);
   }
+  unregister_temp(slot_);
 }
 
 void AtomicOutput::commit() {
@@ -43,6 +120,43 @@ void AtomicOutput::commit() {
   fs::rename(temp_, final_, ec);
   if (ec) throw OutputError("cannot move the output into place at '" + final_ + "': " + ec.message());
   committed_ = true;
+}
+
+AtomicDirectory::AtomicDirectory(std::string final_path) : final_(std::move(final_path)) {
+  while (!final_.empty() && final_.back() == '/') final_.pop_back();
+  ensure_writable_directory(fs::path(final_).parent_path().string());
+  temp_ = temp_name_beside(final_);
+  slot_ = register_temp(temp_);
+  std::error_code ec;
+  fs::create_directories(temp_, ec);
+  if (ec) throw OutputError("cannot create folder '" + temp_ + "': " + ec.message());
+}
+
+AtomicDirectory::~AtomicDirectory() {
+  if (!committed_) {
+    std::error_code ec;
+    fs::remove_all(temp_, ec);
+  }
+  unregister_temp(slot_);
+}
+
+void AtomicDirectory::commit() {
+  std::error_code ec;
+  // A folder cannot be renamed over a non-empty one: move the old one aside first, and
+  // only delete it once the new one is in place.
+  std::string old;
+  if (fs::exists(final_, ec)) {
+    old = temp_name_beside(final_ + ".old");
+    fs::rename(final_, old, ec);
+    if (ec) throw OutputError("cannot replace the existing '" + final_ + "': " + ec.message());
+  }
+  fs::rename(temp_, final_, ec);
+  if (ec) {
+    if (!old.empty()) fs::rename(old, final_, ec);
+    throw OutputError("cannot move the output folder into place at '" + final_ + "'");
+  }
+  committed_ = true;
+  if (!old.empty()) fs::remove_all(old, ec);
 }
 
 void write_text_file_atomically(const std::string& path, const std::string& text) {

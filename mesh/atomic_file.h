@@ -28,6 +28,34 @@ class AtomicOutput {
   std::string final_;
   std::string temp_;
   bool committed_ = false;
+  int slot_ = -1;  ///< entry in the interrupt-cleanup table
+};
+
+/// Installs SIGINT/SIGTERM handlers that remove every live temporary (files and folders of
+/// AtomicOutput and AtomicDirectory) and then exit with 128 + the signal number. Call once
+/// from main.
+void install_interrupt_cleanup();
+
+/// A folder being written (e.g. a model): fill temp_path(), then commit() renames it to
+/// the final path, replacing an existing folder of that name. Removed if never committed.
+class AtomicDirectory {
+ public:
+  /// \throw OutputError if the parent folder cannot be created or written.
+  explicit AtomicDirectory(std::string final_path);
+  ~AtomicDirectory();
+  AtomicDirectory(const AtomicDirectory&) = delete;
+  AtomicDirectory& operator=(const AtomicDirectory&) = delete;
+
+  const std::string& temp_path() const { return temp_; }
+  const std::string& final_path() const { return final_; }
+  /// \throw OutputError if the rename fails.
+  void commit();
+
+ private:
+  std::string final_;
+  std::string temp_;
+  bool committed_ = false;
+  int slot_ = -1;  ///< entry in the interrupt-cleanup table
 };
 
 /// Writes a whole text file atomically.
