@@ -204,10 +204,15 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     stats = estimate_region_stats(samplers[pyr[0]], V, N, 2.0 * spacings[pyr[0]], 0.5 * spacings[pyr[0]]);
   }
   if (options.init == InitMode::moments_and_fit || options.init == InitMode::fit) {
-    const auto [search, step] = search_for(0, range_for(0, options.coarse_range_edge_fraction), stats);
+    // Fit the whole mesh of a level with enough vertices to carry the shape; synthesis
+    // follows a similarity, so the pose found there applies to S_0 as well.
+    const int jf = std::min(L, options.fit_level);
+    RowMatrixX3d W = pose.apply(model.levels[jf]);
+    const auto [search, step] = search_for(jf, range_for(jf, options.coarse_range_edge_fraction), stats);
     (void)step;
-    const Similarity fitted = fit_similarity_to_targets(V, model.faces(0), search, options.fit, &result.fit_iterations);
+    const Similarity fitted = fit_similarity_to_targets(W, model.faces(jf), search, options.fit, &result.fit_iterations);
     pose = fitted.compose(pose);
+    V = pose.apply(model.levels[0]);
     if (!model.appearance) {
       vertex_normals(V, model.faces(0), N);
       stats = estimate_region_stats(samplers[pyr[0]], V, N, 2.0 * spacings[pyr[0]], 0.5 * spacings[pyr[0]]);

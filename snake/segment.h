@@ -62,12 +62,13 @@ struct SegmentOptions {
   InitMode init = InitMode::moments_and_fit;
   ForceMode force = ForceMode::automatic;  ///< automatic: profile when the model has an appearance
   TargetFitOptions fit;
+  int fit_level = 2;  ///< the mesh level whose vertices the similarity fit uses (capped at L)
   MomentsOptions moments;
   /// Search range at level j: max(min_range_voxels·voxel, range_edge_fraction·edge_j); the
   /// coarsest level uses coarse_range_edge_fraction for the initial fit.
   double range_edge_fraction = 0.5;
   double coarse_range_edge_fraction = 0.75;
-  double min_range_voxels = 2.5;
+  double min_range_voxels = 4.0;
   double step_voxels = 0.5;       ///< search step, in voxels of the pyramid level
   double window_voxels = 2.0;     ///< step_edge half window, in voxels of the pyramid level
   double edge_per_voxel = 2.0;    ///< pyramid level choice (appearance.h)

@@ -6,6 +6,9 @@
 #include <chrono>
 #include <cstdio>
 
+#include "mesh/distance.h"
+#include "mesh/mesh_io.h"
+#include "mesh/marching_cubes.h"
 #include "snake/evaluate.h"
 #include "snake/image_pyramid.h"
 #include "snake/rasterize.h"
@@ -55,13 +58,41 @@ CaseOutcome run_case(SynthShape shape, std::uint64_t target_seed, std::uint64_t 
   const SynthResult target = make_instance(shape, target_seed, 4.0, size);
   const SynthResult ref = make_instance(shape, model_seed, 4.0, size);
   const SnakeModel model = build_test_model(ref, levels, &out.model_fit_mm);
+  const SegmentationScores own = evaluate_segmentation(
+      rasterize_mesh(TriMesh{model.levels.back(), model.faces(model.finest_level())}, ref.truth), ref.truth);
+  std::printf("model on its own instance: Dice %.4f ASSD %.3f\n", own.dice, own.assd_mm);
   const auto t0 = std::chrono::steady_clock::now();
-  const SegmentResult r = segment(target.image, model, options);
+  SegmentOptions opts = options;
+  if (const char* f = std::getenv("MRSNAKE_E2E_FORCE")) opts.force = parse_force_mode(f);
+  const SegmentResult r = segment(target.image, model, opts);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   out.start = evaluate_segmentation(rasterize_mesh(TriMesh{model.levels.back(), model.faces(model.finest_level())}, target.truth),
                                     target.truth);
+  const SegmentationScores initial = evaluate_segmentation(
+      rasterize_mesh(TriMesh{r.initial_pose.apply(model.levels.back()), model.faces(model.finest_level())}, target.truth),
+      target.truth);
+  std::printf("after initialization: Dice %.4f (fit iterations %d)\n", initial.dice, r.fit_iterations);
   out.final = evaluate_segmentation(rasterize_mesh(r.surface, target.truth), target.truth);
   out.self_intersections = r.self_intersections;
+  if (std::getenv("MRSNAKE_E2E_DUMP")) {
+    const SurfaceLocator loc(target.truth_mesh);
+    const Eigen::VectorXd d = loc.distances(r.surface.V);
+    int over1 = 0;
+    for (int i = 0; i < d.size(); ++i) over1 += d[i] > 1.0;
+    std::printf("enclosed volume final/truth %.4f, model/ref %.4f\n", enclosed_volume(r.surface) / enclosed_volume(target.truth_mesh), enclosed_volume(TriMesh{model.levels.back(), model.faces(model.finest_level())}) / enclosed_volume(ref.truth_mesh));
+    for (const auto& l : r.levels) std::printf("  level %d volume ratio %.4f\n", l.level, enclosed_volume(l.surface) / enclosed_volume(target.truth_mesh));
+    std::printf("vertex-to-truth: mean %.3f max %.3f, >1mm: %d of %d\n", d.mean(), d.maxCoeff(), over1, int(d.size()));
+    const std::string dir = std::string("/tmp/e2e_") + to_string(shape);
+    std::system(("mkdir -p " + dir).c_str());
+    write_mesh(dir + "/final.vtp", r.surface);
+    write_mesh(dir + "/truth.vtp", target.truth_mesh);
+    write_mesh(dir + "/model.vtp", TriMesh{model.levels.back(), model.faces(model.finest_level())});
+    for (const auto& l : r.levels) write_mesh(dir + "/level_" + std::to_string(l.level) + ".vtp", l.surface);
+    std::FILE* f = std::fopen((dir + "/err.txt").c_str(), "w");
+    for (int i = 0; i < d.size(); ++i) std::fprintf(f, "%f %f %f %f\n", r.surface.V(i, 0), r.surface.V(i, 1), r.surface.V(i, 2), d[i]);
+    std::fclose(f);
+  }
+  std::printf("volume difference %.2f%%\n", out.final.volume_difference_pct);
   std::printf("%-9s start Dice %.3f  final Dice %.4f ASSD %.3f HD95 %.3f  self-int %d  %.2fs (model fit %.2f mm)\n",
               to_string(shape).c_str(), out.start.dice, out.final.dice, out.final.assd_mm, out.final.hd95_mm,
               out.self_intersections, out.seconds, out.model_fit_mm);
@@ -89,7 +120,7 @@ TEST(SegmentE2E, Blob) {
 }
 
 TEST(SegmentE2E, Aneurysm) {
-  const CaseOutcome c = run_case(SynthShape::aneurysm, 31, 32);
+  const CaseOutcome c = run_case(SynthShape::aneurysm, 31, 32, 64, 5);
   EXPECT_GE(c.final.dice, 0.95);
   EXPECT_LE(c.final.assd_mm, 0.5);
   EXPECT_EQ(c.self_intersections, 0);
