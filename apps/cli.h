@@ -31,6 +31,7 @@ void print_json(const nlohmann::json& j);
 
 // One registration function per subcommand (apps/cmd_*.cpp).
 void add_info_command(CLI::App& app);
+void add_model_info_command(CLI::App& app);
 void add_quality_command(CLI::App& app);
 void add_mc_command(CLI::App& app);
 

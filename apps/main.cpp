@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   app.footer("Run 'mrsnake <command> --help' for a command's options and an example.");
 
   cli::add_info_command(app);
+  cli::add_model_info_command(app);
   cli::add_quality_command(app);
   cli::add_mc_command(app);
 

@@ -6,7 +6,7 @@ find_package(VTK REQUIRED COMPONENTS
   CommonCore CommonDataModel CommonExecutionModel CommonTransforms
   FiltersCore FiltersGeneral FiltersModeling FiltersSources FiltersGeometry
   ImagingCore IOGeometry IOLegacy IOPLY IOXML
-  RenderingCore RenderingOpenGL2 InteractionStyle IOImage)
+  RenderingCore RenderingOpenGL2 RenderingAnnotation InteractionStyle IOImage)
 # ITK bundles Eigen 3.3 under its include directory. Its include path must never reach a
 # translation unit that includes the system Eigen or CGAL, so ITK is only linked PRIVATE
 # into the small *_itk targets (see mrsnake_add_itk_library).

@@ -1,0 +1,97 @@
+// mrsnake model-info MODEL: the manifest of a shape model, and a check that synthesis from
+// its base and details rebuilds the stored finest level.
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+
+#include "apps/cli.h"
+#include "mesh/errors.h"
+#include "wavelets/model_io.h"
+
+namespace mrsnake::cli {
+namespace {
+
+std::string format(const char* fmt, double v) {
+  char s[64];
+  std::snprintf(s, sizeof s, fmt, v);
+  return s;
+}
+
+}  // namespace
+
+void add_model_info_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand("model-info", "Print a shape model's manifest and check that its details rebuild the finest level");
+  auto model_path = std::make_shared<std::string>();
+  auto json = std::make_shared<bool>(false);
+  cmd->add_option("MODEL", *model_path, "Model folder (made by 'mrsnake build-model')")->required();
+  cmd->add_flag("--json", *json, "Print JSON instead of text");
+  cmd->footer("Example: mrsnake model-info liver.model --json");
+  cmd->callback([=] {
+    LoadModelOptions load;
+    load.level_meshes = true;
+    const ShapeModel model = load_model(*model_path, load);
+    const nlohmann::json manifest = read_model_manifest(*model_path);
+    const auto t0 = std::chrono::steady_clock::now();
+    const RowMatrixX3d S = synthesize(model);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const RowMatrixX3d& stored = model.level_positions.back();
+    const Eigen::VectorXd err = (S - stored).rowwise().norm();
+    const double diag = bounding_box_diagonal(stored);
+    const double max_err = err.maxCoeff(), rms_err = std::sqrt(err.squaredNorm() / err.size());
+    const bool ok = max_err <= 1e-9 * diag;
+    nlohmann::json synthesis = {{"level", model.levels()},
+                                {"max_error_mm", max_err},
+                                {"rms_error_mm", rms_err},
+                                {"max_error_relative_to_diagonal", diag > 0 ? max_err / diag : 0.0},
+                                {"bounding_box_diagonal_mm", diag},
+                                {"seconds", seconds},
+                                {"ok", ok}};
+    if (*json) {
+      print_json({{"model", *model_path}, {"manifest", manifest}, {"synthesis", synthesis}});
+    } else {
+      std::cout << *model_path << ": mrsnake model, format version " << manifest["format_version"] << '\n';
+      if (!model.source_image.empty() || model.source_label)
+        std::cout << "  source            " << model.source_image
+                  << (model.source_label ? ", label " + std::to_string(*model.source_label) : std::string()) << '\n';
+      if (model.physical_frame) {
+        const PhysicalFrame& f = *model.physical_frame;
+        std::cout << "  image grid        " << f.size[0] << "x" << f.size[1] << "x" << f.size[2] << " voxels of "
+                  << f.spacing[0] << "x" << f.spacing[1] << "x" << f.spacing[2] << " mm\n";
+      }
+      std::cout << "  wavelet           " << manifest["wavelet"]["predict"].get<std::string>() << " predict, "
+                << manifest["wavelet"]["update"].get<std::string>() << " update, "
+                << manifest["wavelet"]["detail_frame"].get<std::string>() << " details\n"
+                << "  levels            " << model.levels() << '\n'
+                << "  level   vertices      faces   detail rms (mm)   detail max (mm)\n";
+      const auto& vc = manifest["vertex_counts"];
+      const auto& fc = manifest["face_counts"];
+      for (int j = 0; j <= model.levels(); ++j) {
+        std::printf("  %5d %10d %10d", j, vc[j].get<int>(), fc[j].get<int>());
+        if (j > 0) std::printf("   %15.6g   %15.6g", model.detail_stats.at(j - 1).rms, model.detail_stats.at(j - 1).max);
+        std::printf("\n");
+      }
+      std::fflush(stdout);
+      if (!model.remesh_quality.is_null())
+        std::cout << "  remesh quality    " << model.remesh_quality.dump() << '\n';
+      if (!model.timings.empty()) {
+        std::cout << "  timings (s)      ";
+        for (const auto& [stage, s] : model.timings) std::cout << ' ' << stage << ' ' << format("%.3f", s);
+        std::cout << '\n';
+      }
+      if (!model.sections.empty()) {
+        std::cout << "  sections         ";
+        for (const auto& [name, blob] : model.sections) std::cout << ' ' << name << " (" << blob.size() << " bytes)";
+        std::cout << '\n';
+      }
+      std::cout << "  synthesis of S_" << model.levels() << " from S_0 and the details: max error "
+                << format("%.3g", max_err) << " mm (" << format("%.3g", diag > 0 ? max_err / diag : 0.0)
+                << " of the diagonal), rms " << format("%.3g", rms_err) << " mm, " << format("%.2f", seconds * 1e3)
+                << " ms: " << (ok ? "ok" : "MISMATCH") << '\n';
+    }
+    if (!ok)
+      throw InputError("the details of model '" + *model_path + "' do not rebuild its stored finest level (error " +
+                       format("%.3g", max_err) + " mm); the model is inconsistent: rebuild it");
+  });
+}
+
+}  // namespace mrsnake::cli

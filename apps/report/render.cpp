@@ -1,0 +1,135 @@
+#include "apps/report/render.h"
+
+#include <X11/Xlib.h>
+#include <vtkActor.h>
+#include <vtkCamera.h>
+#include <vtkCellData.h>
+#include <vtkDoubleArray.h>
+#include <vtkLookupTable.h>
+#include <vtkNew.h>
+#include <vtkPNGWriter.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkPolyDataNormals.h>
+#include <vtkProperty.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
+#include <vtkTextProperty.h>
+#include <vtkUnsignedCharArray.h>
+#include <vtkWindowToImageFilter.h>
+
+#include <cmath>
+#include <cstdlib>
+
+#include "mesh/errors.h"
+#include "mesh/vtk_convert.h"
+
+namespace mrsnake::report {
+
+bool display_available(std::string* why) {
+  const char* name = std::getenv("DISPLAY");
+  if (!name || !*name) {
+    if (why) *why = "no DISPLAY is set (run under xvfb-run -a for 3D pictures)";
+    return false;
+  }
+  Display* display = XOpenDisplay(nullptr);
+  if (!display) {
+    if (why) *why = std::string("the X display '") + name + "' does not answer";
+    return false;
+  }
+  XCloseDisplay(display);
+  return true;
+}
+
+std::vector<std::uint8_t> render_mesh_png(const TriMesh& mesh, const RenderOptions& options) {
+  std::string why;
+  if (!display_available(&why)) throw Error("cannot render: " + why);
+
+  vtkNew<vtkRenderer> renderer;
+  renderer->SetBackground(1, 1, 1);
+  renderer->SetBackground2(0.82, 0.86, 0.92);
+  renderer->GradientBackgroundOn();
+
+  auto poly = to_polydata(mesh);
+  vtkNew<vtkPolyDataMapper> mapper;
+  if (!options.face_scalars.empty()) {
+    vtkNew<vtkDoubleArray> values;
+    values->SetName("value");
+    values->SetNumberOfValues(static_cast<vtkIdType>(options.face_scalars.size()));
+    double lo = 1e300, hi = -1e300;
+    for (std::size_t i = 0; i < options.face_scalars.size(); ++i) {
+      double v = options.face_scalars[i];
+      if (options.log_scale) v = std::log10(std::max(v, 1e-300));
+      values->SetValue(static_cast<vtkIdType>(i), v);
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+    poly->GetCellData()->SetScalars(values);
+    vtkNew<vtkLookupTable> lut;
+    lut->SetHueRange(0.667, 0.0);  // blue (low) to red (high)
+    lut->SetTableRange(lo, hi > lo ? hi : lo + 1);
+    lut->Build();
+    mapper->SetLookupTable(lut);
+    mapper->SetScalarRange(lo, hi > lo ? hi : lo + 1);
+    mapper->SetScalarModeToUseCellData();
+    mapper->ScalarVisibilityOn();
+    vtkNew<vtkScalarBarActor> bar;
+    bar->SetLookupTable(lut);
+    bar->SetTitle((options.scalar_title + (options.log_scale ? " (log10)" : "")).c_str());
+    bar->SetNumberOfLabels(4);
+    bar->SetWidth(0.12);
+    bar->GetTitleTextProperty()->SetColor(0.1, 0.1, 0.1);
+    bar->GetLabelTextProperty()->SetColor(0.1, 0.1, 0.1);
+    renderer->AddActor2D(bar);
+  } else {
+    mapper->ScalarVisibilityOff();
+  }
+  mapper->SetInputData(poly);
+  vtkNew<vtkActor> actor;
+  actor->SetMapper(mapper);
+  actor->GetProperty()->SetColor(0.93, 0.72, 0.55);
+  actor->GetProperty()->SetSpecular(0.2);
+  if (options.wireframe) {
+    actor->GetProperty()->EdgeVisibilityOn();
+    actor->GetProperty()->SetEdgeColor(0.15, 0.15, 0.2);
+    actor->GetProperty()->SetLineWidth(0.6f);
+  }
+  renderer->AddActor(actor);
+
+  if (options.overlay) {
+    vtkNew<vtkPolyDataMapper> overlay_mapper;
+    overlay_mapper->SetInputData(to_polydata(*options.overlay));
+    overlay_mapper->ScalarVisibilityOff();
+    vtkNew<vtkActor> overlay;
+    overlay->SetMapper(overlay_mapper);
+    overlay->GetProperty()->SetColor(0.2, 0.6, 0.3);
+    overlay->GetProperty()->SetOpacity(0.35);
+    renderer->AddActor(overlay);
+  }
+
+  vtkNew<vtkRenderWindow> window;
+  window->SetOffScreenRendering(1);
+  window->SetMultiSamples(4);
+  window->SetSize(options.width, options.height);
+  window->AddRenderer(renderer);
+  renderer->ResetCamera();
+  renderer->GetActiveCamera()->Azimuth(options.azimuth);
+  renderer->GetActiveCamera()->Elevation(options.elevation);
+  renderer->GetActiveCamera()->OrthogonalizeViewUp();
+  renderer->ResetCamera();
+  renderer->GetActiveCamera()->Zoom(1.15);
+  window->Render();
+
+  vtkNew<vtkWindowToImageFilter> grab;
+  grab->SetInput(window);
+  grab->ReadFrontBufferOff();
+  grab->Update();
+  vtkNew<vtkPNGWriter> writer;
+  writer->SetInputConnection(grab->GetOutputPort());
+  writer->WriteToMemoryOn();
+  writer->Write();
+  vtkUnsignedCharArray* result = writer->GetResult();
+  return {result->GetPointer(0), result->GetPointer(0) + result->GetNumberOfValues()};
+}
+
+}  // namespace mrsnake::report
