@@ -34,5 +34,6 @@ void add_info_command(CLI::App& app);
 void add_model_info_command(CLI::App& app);
 void add_quality_command(CLI::App& app);
 void add_mc_command(CLI::App& app);
+void add_segment_command(CLI::App& app);
 
 }  // namespace mrsnake::cli

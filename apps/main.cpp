@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   cli::add_model_info_command(app);
   cli::add_quality_command(app);
   cli::add_mc_command(app);
+  cli::add_segment_command(app);
 
   try {
     app.parse(argc, argv);

@@ -9,7 +9,13 @@
 #include "mesh/distance.h"
 #include "mesh/mesh_io.h"
 #include "mesh/marching_cubes.h"
+#include "mesh/image_io.h"
 #include "snake/evaluate.h"
+#include "snake/model_bridge.h"
+#include "tests/test_support.h"
+#include "wavelets/model_io.h"
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include "snake/image_pyramid.h"
 #include "snake/rasterize.h"
 #include "snake/segment.h"
@@ -39,17 +45,20 @@ SynthResult make_instance(SynthShape shape, std::uint64_t seed, double snr, int 
 }
 
 // The model: a shrink-wrapped semi-regular sphere on the reference instance's truth
-// surface, with the appearance learned from the reference image.
-SnakeModel build_test_model(const SynthResult& ref, int levels, double* fit_mm) {
+// surface, analyzed by the lifting wavelets (butterfly, local frames), with the appearance
+// learned from the reference image.
+ShapeModel build_shape_model(const SynthResult& ref, int levels, double* fit_mm) {
   ShrinkWrapOptions so;
   so.levels = levels;
   const ShrinkWrapResult wrap = shrink_wrap(ref.truth_mesh, so);
   if (fit_mm) *fit_mm = wrap.mean_distance_mm;
-  SnakeModel model = midpoint_frame_model(wrap.connectivity, wrap.finest);
-  Volume normalized = ref.image;
-  normalize_intensities(normalized);
-  model.appearance = build_appearance(build_pyramid(normalized, 8), model.levels, model.connectivity.faces);
+  ShapeModel model = make_model(wrap.connectivity, wrap.finest);
+  add_appearance(model, ref.image);
   return model;
+}
+
+SnakeModel build_test_model(const SynthResult& ref, int levels, double* fit_mm) {
+  return snake_model_from(build_shape_model(ref, levels, fit_mm));
 }
 
 CaseOutcome run_case(SynthShape shape, std::uint64_t target_seed, std::uint64_t model_seed, int size = 64,
@@ -131,4 +140,39 @@ TEST(SegmentE2E, Heart) {
   EXPECT_GE(c.final.dice, 0.95);
   EXPECT_LE(c.final.assd_mm, 0.5);
   EXPECT_EQ(c.self_intersections, 0);
+}
+
+TEST(SegmentCommand, WritesEveryOutputOnTheImageGridWithScores) {
+  const auto dir = mrsnake::test::scratch_dir("segment-cli");
+  const SynthResult target = make_instance(SynthShape::blob, 51, 4.0, 48);
+  const SynthResult ref = make_instance(SynthShape::blob, 52, 4.0, 48);
+  save_model((dir / "blob.model").string(), build_shape_model(ref, 4, nullptr));
+  // An oblique, anisotropic grid: the outputs must keep it.
+  Volume image = target.image, truth = target.truth;
+  write_volume((dir / "image.nii.gz").string(), image, VoxelType::float32);
+  write_volume((dir / "truth.nii.gz").string(), truth, VoxelType::uint8);
+  const auto r = mrsnake::test::run_mrsnake("segment --image " + (dir / "image.nii.gz").string() + " --model " +
+                                            (dir / "blob.model").string() + " -o " + (dir / "seg").string() +
+                                            " --truth " + (dir / "truth.nii.gz").string() + " --json -q");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* f : {"surface.vtp", "labels.nii.gz", "report.json", "levels/level_0.vtp", "levels/level_4.vtp"})
+    EXPECT_TRUE(std::filesystem::exists(dir / "seg" / f)) << f;
+  const Volume labels = read_volume((dir / "seg" / "labels.nii.gz").string());
+  EXPECT_EQ(labels.size, image.size);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(labels.spacing[a], image.spacing[a], 1e-6);
+    EXPECT_NEAR(labels.origin[a], image.origin[a], 1e-4);
+  }
+  std::ifstream in(dir / "seg" / "report.json");
+  const nlohmann::json rep = nlohmann::json::parse(in);
+  EXPECT_EQ(rep["self_intersections"], 0);
+  EXPECT_EQ(rep["levels"].size(), 5u);
+  EXPECT_TRUE(rep.contains("stage_seconds"));
+  EXPECT_GE(rep["scores"]["dice"].get<double>(), 0.95);
+  // Bad input: a missing model is a one-line error with exit code 3, and nothing is written.
+  const auto bad = mrsnake::test::run_mrsnake("segment --image " + (dir / "image.nii.gz").string() + " --model " +
+                                              (dir / "nope.model").string() + " -o " + (dir / "seg2").string());
+  EXPECT_EQ(bad.exit_code, 3) << bad.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "seg2"));
+  std::filesystem::remove_all(dir);
 }
