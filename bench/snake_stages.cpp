@@ -59,10 +59,10 @@ int main(int argc, char** argv) {
   std::printf("| rasterize labels | %.3f |\n", raster);
   std::printf("| **compute (normalize..levels)** | **%.3f** |\n| segment() incl. self-intersection count | %.3f |\n",
               r.compute_seconds, total);
-  std::printf("\n| level | vertices | pyramid | iterations | converged | seconds |\n|---|---|---|---|---|---|\n");
+  std::printf("\n| level | vertices | pyramid | iterations | converged | synthesis s | total s |\n|---|---|---|---|---|---|---|\n");
   for (const auto& l : r.levels)
-    std::printf("| %d | %d | %d | %d | %s | %.3f |\n", l.level, l.vertices, l.pyramid_level, l.snake.iterations,
-                l.snake.converged ? "yes" : "no", l.seconds);
+    std::printf("| %d | %d | %d | %d | %s | %.3f | %.3f |\n", l.level, l.vertices, l.pyramid_level, l.snake.iterations,
+                l.snake.converged ? "yes" : "no", l.synthesis_seconds, l.seconds);
   std::printf("\nDice %.4f  ASSD %.3f mm  HD95 %.3f mm  self-intersections %d  peak RSS %.0f MB\n", s.dice, s.assd_mm,
               s.hd95_mm, r.self_intersections, ru.ru_maxrss / 1024.0);
   return 0;

@@ -71,9 +71,12 @@ SearchResult search_profiles(const VolumeSampler& image, const RowMatrixX3d& V, 
                              const NormalSearchOptions& options) {
   const int K = static_cast<int>(profiles.cols());
   const int half = K / 2;
-  const double h = profile_spacing_mm;
+  // Samples and candidates on a grid `sub` times finer than the profile spacing: the
+  // profile's k-th sample of candidate c is sample c + sub·k.
+  const int sub = std::max(1, static_cast<int>(std::lround(profile_spacing_mm / options.step_mm)));
+  const double h = profile_spacing_mm / sub;
   const int nc = std::max(0, static_cast<int>(std::floor(options.range_mm / h)));
-  const int ns = 2 * nc + K;  // samples at offsets (s − nc − half)·h
+  const int ns = 2 * nc + sub * (K - 1) + 1;  // samples at offsets (s − nc − sub·half)·h
   SearchResult r;
   r.offsets.setZero(V.rows());
   r.costs.setZero(V.rows());
@@ -97,12 +100,12 @@ SearchResult search_profiles(const VolumeSampler& image, const RowMatrixX3d& V, 
     const double inv = 1.0 / std::sqrt(norm2);
     for (double& m : model) m *= inv;
     const Eigen::Vector3d x = V.row(v), n = N.row(v);
-    for (int s = 0; s < ns; ++s) samples[s] = image.value(x + ((s - nc - half) * h) * n);
+    for (int s = 0; s < ns; ++s) samples[s] = image.value(x + ((s - nc - sub * half) * h) * n);
     int best = nc;
     for (int c = 0; c <= 2 * nc; ++c) {
       double sum = 0, sum2 = 0, dot = 0;
       for (int k = 0; k < K; ++k) {
-        const double y = samples[c + k];
+        const double y = samples[c + sub * k];
         sum += y;
         sum2 += y * y;
         dot += y * model[k];  // model is centred, so the mean of y drops out

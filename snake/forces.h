@@ -52,7 +52,8 @@ SearchResult search_step_edges(const VolumeSampler& image, const RowMatrixX3d& V
 
 /// Profile search: each vertex's learned profile (row v of `profiles`, K samples spaced
 /// profile_spacing_mm and centred on the surface) is slid along the normal in steps of
-/// profile_spacing_mm within ±range_mm; the cost is 1 − normalized correlation.
+/// options.step_mm (rounded to a whole fraction of the spacing) within ±range_mm; the cost
+/// is 1 − normalized correlation.
 /// \pre profiles has V.rows() rows and an odd number of columns.
 SearchResult search_profiles(const VolumeSampler& image, const RowMatrixX3d& V, const RowMatrixX3d& N,
                              const Eigen::MatrixXf& profiles, double profile_spacing_mm,

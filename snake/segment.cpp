@@ -197,7 +197,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   }
   RegionStats stats;
   RowMatrixX3d N;
-  if (model.appearance) {
+  if (use_profiles) {
     stats = model.appearance->region;
   } else {
     vertex_normals(V, model.faces(0), N);
@@ -213,7 +213,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     const Similarity fitted = fit_similarity_to_targets(W, model.faces(jf), search, options.fit, &result.fit_iterations);
     pose = fitted.compose(pose);
     V = pose.apply(model.levels[0]);
-    if (!model.appearance) {
+    if (!use_profiles) {
       vertex_normals(V, model.faces(0), N);
       stats = estimate_region_stats(samplers[pyr[0]], V, N, 2.0 * spacings[pyr[0]], 0.5 * spacings[pyr[0]]);
     }
@@ -229,7 +229,19 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   for (int j = 0; j <= L; ++j) {
     const auto t_level = Clock::now();
     report(progress, "level " + std::to_string(j), static_cast<double>(j) / (L + 1));
-    if (j > 0) V = model.synthesize(j - 1, V);
+    double synthesis_seconds = 0;
+    if (j > 0) {
+      const auto t_syn = Clock::now();
+      V = model.synthesize(j - 1, V);
+      synthesis_seconds = seconds_since(t_syn);
+    }
+    if (!use_profiles && j > 0) {
+      // Once the surface is near the boundary, the full-resolution shells inside and
+      // outside give unbiased region statistics (coarse levels blur thin parts).
+      vertex_normals(V, model.faces(j), N);
+      const RegionStats fresh = estimate_region_stats(samplers[0], V, N, 3.0 * spacings[0], spacings[0]);
+      if (std::abs(fresh.inside - fresh.outside) > 0.5 * std::abs(stats.inside - stats.outside)) stats = fresh;
+    }
     const double range = range_for(j, options.range_edge_fraction);
     const auto [search, step] = search_for(j, range, stats);
     const DeformableSurface snake(model.faces(j), model.levels[j], options.snake);
@@ -239,6 +251,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     out.voxel_mm = spacings[pyr[j]];
     out.range_mm = range;
     out.vertices = static_cast<int>(V.rows());
+    out.synthesis_seconds = synthesis_seconds;
     out.snake = snake.run(V, search, step);
     out.seconds = seconds_since(t_level);
     out.surface = TriMesh{V, model.faces(j)};
@@ -284,6 +297,7 @@ nlohmann::json segment_report(const SegmentResult& r) {
                       {"iterations", l.snake.iterations},
                       {"converged", l.snake.converged},
                       {"seconds", l.seconds},
+                      {"synthesis_seconds", l.synthesis_seconds},
                       {"energy", l.snake.energy},
                       {"external_energy", l.snake.external_energy},
                       {"internal_energy", l.snake.internal_energy},

@@ -83,6 +83,7 @@ struct LevelOutcome {
   int vertices = 0;
   SnakeLevelReport snake;
   double seconds = 0;          ///< synthesis + snake of this level
+  double synthesis_seconds = 0;
   TriMesh surface;             ///< S_j after deformation
 };
 

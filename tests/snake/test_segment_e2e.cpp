@@ -52,6 +52,7 @@ ShapeModel build_shape_model(const SynthResult& ref, int levels, double* fit_mm)
   so.levels = levels;
   const ShrinkWrapResult wrap = shrink_wrap(ref.truth_mesh, so);
   if (fit_mm) *fit_mm = wrap.mean_distance_mm;
+  std::printf("shrink wrap: target-to-wrap mean %.3f max %.3f mm\n", wrap.mean_distance_mm, wrap.max_distance_mm);
   ShapeModel model = make_model(wrap.connectivity, wrap.finest);
   add_appearance(model, ref.image);
   return model;
