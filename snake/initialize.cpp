@@ -10,6 +10,7 @@
 
 #include "mesh/errors.h"
 #include "snake/rasterize.h"
+#include "snake/sampler.h"
 
 namespace mrsnake {
 
@@ -90,6 +91,63 @@ double otsu_threshold(const Volume& image, const std::array<long, 3>& lo, const 
   return mn + (best_b + 1) / scale;
 }
 
+void mesh_index_box(const Volume& image, const RowMatrixX3d& V, double margin, std::array<long, 3>& lo,
+                    std::array<long, 3>& hi) {
+  Eigen::Vector3d mn = Eigen::Vector3d::Constant(std::numeric_limits<double>::max()), mx = -mn;
+  for (int v = 0; v < V.rows(); ++v) {
+    const auto idx = image.physical_to_index({V(v, 0), V(v, 1), V(v, 2)});
+    const Eigen::Vector3d x(idx[0], idx[1], idx[2]);
+    mn = mn.cwiseMin(x);
+    mx = mx.cwiseMax(x);
+  }
+  const Eigen::Vector3d m = margin * (mx - mn);
+  for (int a = 0; a < 3; ++a) {
+    const long last = static_cast<long>(image.size[a]) - 1;
+    lo[a] = std::clamp(static_cast<long>(std::floor(mn[a] - m[a])), 0L, last);
+    hi[a] = std::clamp(static_cast<long>(std::ceil(mx[a] + m[a])), 0L, last);
+  }
+}
+
+ThresholdClasses threshold_classes(const Volume& image, const Volume& smooth, const std::array<long, 3>& lo,
+                                   const std::array<long, 3>& hi) {
+  ThresholdClasses c;
+  // The box in the smooth image's indices.
+  std::array<long, 3> slo{}, shi{};
+  for (int a = 0; a < 3; ++a) {
+    slo[a] = std::numeric_limits<long>::max();
+    shi[a] = std::numeric_limits<long>::min();
+  }
+  for (long corner = 0; corner < 8; ++corner) {
+    const auto p = image.index_to_physical(static_cast<double>((corner & 1) ? hi[0] : lo[0]),
+                                           static_cast<double>((corner & 2) ? hi[1] : lo[1]),
+                                           static_cast<double>((corner & 4) ? hi[2] : lo[2]));
+    const auto q = smooth.physical_to_index(p);
+    for (int a = 0; a < 3; ++a) {
+      const long last = static_cast<long>(smooth.size[a]) - 1;
+      slo[a] = std::min(slo[a], std::clamp(static_cast<long>(std::floor(q[a])), 0L, last));
+      shi[a] = std::max(shi[a], std::clamp(static_cast<long>(std::ceil(q[a])), 0L, last));
+    }
+  }
+  c.threshold = otsu_threshold(smooth, slo, shi);
+  const VolumeSampler coarse(smooth);
+  std::vector<float> upper, lower;
+  for (long k = lo[2]; k <= hi[2]; ++k)
+    for (long j = lo[1]; j <= hi[1]; ++j)
+      for (long i = lo[0]; i <= hi[0]; ++i) {
+        const auto p = image.index_to_physical(static_cast<double>(i), static_cast<double>(j), static_cast<double>(k));
+        const float v = image.at(i, j, k);
+        (coarse.value(Eigen::Vector3d(p[0], p[1], p[2])) > c.threshold ? upper : lower).push_back(v);
+      }
+  const auto median = [](std::vector<float>& a) {
+    if (a.empty()) return 0.0;
+    std::nth_element(a.begin(), a.begin() + static_cast<long>(a.size() / 2), a.end());
+    return static_cast<double>(a[a.size() / 2]);
+  };
+  c.upper_median = median(upper);
+  c.lower_median = median(lower);
+  return c;
+}
+
 namespace {
 // Eigenvectors sorted by decreasing eigenvalue, as a right-handed rotation's columns.
 void principal_axes(const Eigen::Matrix3d& cov, Eigen::Matrix3d& axes, Eigen::Vector3d& values) {
@@ -103,20 +161,7 @@ void principal_axes(const Eigen::Matrix3d& cov, Eigen::Matrix3d& axes, Eigen::Ve
 Similarity moments_alignment(const Volume& image, const TriMesh& model, const MomentsOptions& options) {
   // Region of interest: the model's box in index space, grown.
   std::array<long, 3> lo{}, hi{};
-  {
-    Eigen::Vector3d mn = Eigen::Vector3d::Constant(std::numeric_limits<double>::max()), mx = -mn;
-    for (int v = 0; v < model.num_vertices(); ++v) {
-      const auto idx = image.physical_to_index({model.V(v, 0), model.V(v, 1), model.V(v, 2)});
-      const Eigen::Vector3d x(idx[0], idx[1], idx[2]);
-      mn = mn.cwiseMin(x);
-      mx = mx.cwiseMax(x);
-    }
-    const Eigen::Vector3d margin = options.roi_margin * (mx - mn);
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::clamp(static_cast<long>(std::floor(mn[a] - margin[a])), 0L, static_cast<long>(image.size[a]) - 1);
-      hi[a] = std::clamp(static_cast<long>(std::ceil(mx[a] + margin[a])), 0L, static_cast<long>(image.size[a]) - 1);
-    }
-  }
+  mesh_index_box(image, model.V, options.roi_margin, lo, hi);
   const double threshold = std::isnan(options.threshold) ? otsu_threshold(image, lo, hi) : options.threshold;
   Volume mask;
   mask.size = image.size;

@@ -37,6 +37,23 @@ Moments mask_moments(const Volume& mask);
 /// Otsu's threshold of the voxels of `image` within the axis-aligned index box [lo, hi].
 double otsu_threshold(const Volume& image, const std::array<long, 3>& lo, const std::array<long, 3>& hi);
 
+/// The index box of `image` covering the mesh's bounding box grown by `margin` (a fraction
+/// of its size) on each side, clamped to the image.
+void mesh_index_box(const Volume& image, const RowMatrixX3d& V, double margin, std::array<long, 3>& lo,
+                    std::array<long, 3>& hi);
+
+/// Two-class statistics near a surface: Otsu's threshold on `smooth` (a coarser, less
+/// noisy version of `image`, e.g. a pyramid level) within the box of `image` indices [lo, hi],
+/// then the medians of `image`'s voxels in the box whose smooth value is above and below it.
+/// The smoothing keeps Otsu from splitting the noise of a large background when the object
+/// is small. What the edge force needs on a clean-contrast image, whatever the pose.
+struct ThresholdClasses {
+  double threshold = 0;
+  double upper_median = 0, lower_median = 0;
+};
+ThresholdClasses threshold_classes(const Volume& image, const Volume& smooth, const std::array<long, 3>& lo,
+                                   const std::array<long, 3>& hi);
+
 struct MomentsOptions {
   double roi_margin = 0.3;  ///< the region of interest: the model's box grown by this fraction per side
   bool rotate = true;       ///< also align principal axes (when they are well separated)

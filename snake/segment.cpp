@@ -189,7 +189,9 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     const int jm = std::min(L, 2);
     MomentsOptions mo = options.moments;
     if (model.appearance && std::isnan(mo.threshold)) {
-      mo.threshold = 0.5 * (model.appearance->region.inside + model.appearance->region.outside);
+      // Towards the inside class: a neighbour of intermediate intensity stays out.
+      mo.threshold = model.appearance->region.outside +
+                     0.7 * (model.appearance->region.inside - model.appearance->region.outside);
       mo.bright_object = model.appearance->region.inside > model.appearance->region.outside;
     }
     pose = moments_alignment(pyramid[p], TriMesh{model.levels[jm], model.faces(jm)}, mo);
@@ -197,11 +199,19 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   }
   RegionStats stats;
   RowMatrixX3d N;
+  const auto estimate_stats = [&](const RowMatrixX3d& W) {
+    // Two classes near the surface, at full resolution: independent of how well the
+    // surface is placed, so a poor start cannot teach the force the wrong contrast.
+    std::array<long, 3> lo{}, hi{};
+    mesh_index_box(pyramid[0], W, 0.15, lo, hi);
+    const ThresholdClasses c = threshold_classes(pyramid[0], pyramid[std::min<std::size_t>(1, pyramid.size() - 1)], lo, hi);
+    const bool bright = !model.appearance || model.appearance->region.inside >= model.appearance->region.outside;
+    return bright ? RegionStats{c.upper_median, c.lower_median} : RegionStats{c.lower_median, c.upper_median};
+  };
   if (use_profiles) {
     stats = model.appearance->region;
   } else {
-    vertex_normals(V, model.faces(0), N);
-    stats = estimate_region_stats(samplers[pyr[0]], V, N, 2.0 * spacings[pyr[0]], 0.5 * spacings[pyr[0]]);
+    stats = estimate_stats(V);
   }
   if (options.init == InitMode::moments_and_fit || options.init == InitMode::fit) {
     // Fit the whole mesh of a level with enough vertices to carry the shape; synthesis
@@ -213,10 +223,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     const Similarity fitted = fit_similarity_to_targets(W, model.faces(jf), search, options.fit, &result.fit_iterations);
     pose = fitted.compose(pose);
     V = pose.apply(model.levels[0]);
-    if (!use_profiles) {
-      vertex_normals(V, model.faces(0), N);
-      stats = estimate_region_stats(samplers[pyr[0]], V, N, 2.0 * spacings[pyr[0]], 0.5 * spacings[pyr[0]]);
-    }
+    if (!use_profiles) stats = estimate_stats(pose.apply(model.levels[L]));
   }
   if (!use_profiles && !(std::abs(stats.inside - stats.outside) > 1e-6))
     throw AlgorithmError("no contrast between the inside and the outside of the initial surface; check the pose");
@@ -234,13 +241,6 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
       const auto t_syn = Clock::now();
       V = model.synthesize(j - 1, V);
       synthesis_seconds = seconds_since(t_syn);
-    }
-    if (!use_profiles && j > 0) {
-      // Once the surface is near the boundary, the full-resolution shells inside and
-      // outside give unbiased region statistics (coarse levels blur thin parts).
-      vertex_normals(V, model.faces(j), N);
-      const RegionStats fresh = estimate_region_stats(samplers[0], V, N, 3.0 * spacings[0], spacings[0]);
-      if (std::abs(fresh.inside - fresh.outside) > 0.5 * std::abs(stats.inside - stats.outside)) stats = fresh;
     }
     const double range = range_for(j, options.range_edge_fraction);
     const auto [search, step] = search_for(j, range, stats);

@@ -68,6 +68,10 @@ SnakeModel build_test_model(const SynthResult& ref, int levels, double* fit_mm) 
 CaseOutcome run_case(SynthShape shape, std::uint64_t target_seed, std::uint64_t model_seed, int size = 64,
                      int levels = 4, const SegmentOptions& options = {}) {
   CaseOutcome out;
+  if (const char* shift = std::getenv("MRSNAKE_E2E_SEED_SHIFT")) {  // robustness sweeps by hand
+    target_seed += std::strtoull(shift, nullptr, 10);
+    model_seed += std::strtoull(shift, nullptr, 10);
+  }
   const SynthResult target = make_instance(shape, target_seed, 4.0, size);
   const SynthResult ref = make_instance(shape, model_seed, 4.0, size);
   const SnakeModel model = build_test_model(ref, levels, &out.model_fit_mm);
@@ -84,7 +88,7 @@ CaseOutcome run_case(SynthShape shape, std::uint64_t target_seed, std::uint64_t 
   const SegmentationScores initial = evaluate_segmentation(
       rasterize_mesh(TriMesh{r.initial_pose.apply(model.levels.back()), model.faces(model.finest_level())}, target.truth),
       target.truth);
-  std::printf("after initialization: Dice %.4f (fit iterations %d)\n", initial.dice, r.fit_iterations);
+  std::printf("after initialization: Dice %.4f (fit iterations %d), region in %.3f out %.3f\n", initial.dice, r.fit_iterations, r.region.inside, r.region.outside);
   out.final = evaluate_segmentation(rasterize_mesh(r.surface, target.truth), target.truth);
   out.self_intersections = r.self_intersections;
   if (std::getenv("MRSNAKE_E2E_DUMP")) {
