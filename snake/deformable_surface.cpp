@@ -67,13 +67,15 @@ RowMatrixX3d DeformableSurface::internal_forces(const RowMatrixX3d& V) const {
   return compute_internal(rings_, F_, prior_, options_, V, N).force;
 }
 
-SnakeLevelReport DeformableSurface::run(RowMatrixX3d& V, const ExternalSearch& search, double search_step_mm) const {
+SnakeLevelReport DeformableSurface::run(RowMatrixX3d& V, const ExternalSearch& search, double search_step_mm,
+                                       double max_displacement_mm) const {
   const SnakeOptions& o = options_;
   const int n = static_cast<int>(V.rows());
   SnakeLevelReport report;
   RowMatrixX3d N, FN_start, FN_old, FN_new, step(n, 3);
   Eigen::VectorXd L;
   face_normals(V, F_, FN_start);
+  const RowMatrixX3d V_start = V;
   std::deque<double> offset_history, energy_history;
   std::vector<char> flagged(static_cast<std::size_t>(n));
   for (int it = 0; it < o.max_iterations; ++it) {
@@ -118,6 +120,11 @@ SnakeLevelReport DeformableSurface::run(RowMatrixX3d& V, const ExternalSearch& s
       if (std::abs(along) > limit) s -= (along - std::copysign(limit, along)) * nv;
       const double len = s.norm();
       if (len > cap && len > 0) s *= cap / len;
+      // Trust region around the level's start.
+      const Eigen::Vector3d start = V_start.row(v).transpose();
+      const Eigen::Vector3d moved = V.row(v).transpose() + s - start;
+      const double dist = moved.norm();
+      if (dist > max_displacement_mm) s = start + moved * (max_displacement_mm / dist) - V.row(v).transpose();
       step.row(v) = s.transpose();
     }
 

@@ -18,6 +18,7 @@
 /// the normal. Faces whose normal would flip reject the step of their vertices (halved, then
 /// dropped). The run stops when the matched offsets and the energy stop changing.
 #include <functional>
+#include <limits>
 
 #include "mesh/trimesh.h"
 #include "snake/forces.h"
@@ -73,7 +74,10 @@ class DeformableSurface {
   RowMatrixX3d internal_forces(const RowMatrixX3d& V) const;
 
   /// Deforms V in place. `search_step_mm` is the search grid, used by the convergence test.
-  SnakeLevelReport run(RowMatrixX3d& V, const ExternalSearch& search, double search_step_mm) const;
+  /// No vertex moves farther than `max_displacement_mm` from where it started (a trust
+  /// region: each level corrects what its search can see, so a bad start cannot run away).
+  SnakeLevelReport run(RowMatrixX3d& V, const ExternalSearch& search, double search_step_mm,
+                       double max_displacement_mm = std::numeric_limits<double>::infinity()) const;
 
   const VertexRings& rings() const { return rings_; }
   const Eigen::VectorXd& prior() const { return prior_; }

@@ -60,7 +60,7 @@ SearchResult search_step_edges(const VolumeSampler& image, const RowMatrixX3d& V
       cost[c] = misfit * norm + options.distance_penalty * rel * rel;
       if (cost[c] < cost[best]) best = c;
     }
-    r.offsets[v] = (best - nc) * h + refine(cost, best, h);
+    r.offsets[v] = cost[best] <= options.max_cost ? (best - nc) * h + refine(cost, best, h) : 0.0;
     r.costs[v] = cost[best];
   }
   return r;
@@ -117,7 +117,7 @@ SearchResult search_profiles(const VolumeSampler& image, const RowMatrixX3d& V, 
       cost[c] = (1.0 - ncc) + options.distance_penalty * rel * rel;
       if (cost[c] < cost[best]) best = c;
     }
-    r.offsets[v] = (best - nc) * h + refine(cost, best, h);
+    r.offsets[v] = cost[best] <= options.max_cost ? (best - nc) * h + refine(cost, best, h) : 0.0;
     r.costs[v] = cost[best];
   }
   return r;

@@ -163,6 +163,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     if (use_profiles) {
       const LevelAppearance* la = &model.appearance->levels[j];
       so.step_mm = la->spacing_mm;
+      so.max_cost = options.max_profile_cost;
       return {[sampler, la, so](const RowMatrixX3d& V, const RowMatrixX3d& N) {
                 return search_profiles(*sampler, V, N, la->profiles, la->spacing_mm, so);
               },
@@ -170,6 +171,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     }
     so.step_mm = options.step_voxels * spacings[p];
     so.window_mm = options.window_voxels * spacings[p];
+    so.max_cost = options.max_edge_cost;
     return {[sampler, stats, so](const RowMatrixX3d& V, const RowMatrixX3d& N) {
               return search_step_edges(*sampler, V, N, stats, so);
             },
@@ -252,7 +254,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     out.range_mm = range;
     out.vertices = static_cast<int>(V.rows());
     out.synthesis_seconds = synthesis_seconds;
-    out.snake = snake.run(V, search, step);
+    out.snake = snake.run(V, search, step, range);
     out.seconds = seconds_since(t_level);
     out.surface = TriMesh{V, model.faces(j)};
     result.levels.push_back(std::move(out));

@@ -72,6 +72,8 @@ struct SegmentOptions {
   double step_voxels = 0.5;       ///< search step, in voxels of the pyramid level
   double window_voxels = 2.0;     ///< step_edge half window, in voxels of the pyramid level
   double edge_per_voxel = 2.0;    ///< pyramid level choice (appearance.h)
+  double max_edge_cost = 0.35;    ///< step-edge matches worse than this are ignored (forces.h)
+  double max_profile_cost = 0.9;  ///< profile matches with a correlation below 0.1 are ignored
   bool count_self_intersections = true;
 };
 
