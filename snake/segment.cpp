@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "mesh/distance.h"
 #include "mesh/errors.h"
@@ -199,6 +200,16 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     pose = moments_alignment(pyramid[p], TriMesh{model.levels[jm], model.faces(jm)}, mo);
     V = pose.apply(V);
   }
+  // Start hypotheses for the fit: the pose found, and the same without its rotation about
+  // the centroid (principal axes can mislead on elongated or curved shapes).
+  std::vector<Similarity> starts{pose};
+  if (pose.rotation_angle_deg() > 1.0) {
+    const Eigen::Vector3d c = model.levels[0].colwise().mean().transpose();
+    Similarity unrotated = pose;
+    unrotated.rotation.setIdentity();
+    unrotated.translation = pose.apply(c) - pose.scale * c;
+    starts.push_back(unrotated);
+  }
   RegionStats stats;
   RowMatrixX3d N;
   const auto estimate_stats = [&](const RowMatrixX3d& W) {
@@ -219,11 +230,21 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     // Fit the whole mesh of a level with enough vertices to carry the shape; synthesis
     // follows a similarity, so the pose found there applies to S_0 as well.
     const int jf = std::min(L, options.fit_level);
-    RowMatrixX3d W = pose.apply(model.levels[jf]);
     const auto [search, step] = search_for(jf, range_for(jf, options.coarse_range_edge_fraction), stats);
     (void)step;
-    const Similarity fitted = fit_similarity_to_targets(W, model.faces(jf), search, options.fit, &result.fit_iterations);
-    pose = fitted.compose(pose);
+    double best_cost = std::numeric_limits<double>::infinity();
+    for (const Similarity& start : starts) {
+      RowMatrixX3d W = start.apply(model.levels[jf]);
+      int iterations = 0;
+      const Similarity fitted = fit_similarity_to_targets(W, model.faces(jf), search, options.fit, &iterations);
+      vertex_normals(W, model.faces(jf), N);
+      const double cost = search(W, N).costs.mean();
+      if (cost < best_cost) {
+        best_cost = cost;
+        pose = fitted.compose(start);
+        result.fit_iterations = iterations;
+      }
+    }
     V = pose.apply(model.levels[0]);
     if (!use_profiles) stats = estimate_stats(pose.apply(model.levels[L]));
   }
