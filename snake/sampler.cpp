@@ -5,7 +5,8 @@
 
 namespace mrsnake {
 
-VolumeSampler::VolumeSampler(const Volume& volume) : volume_(&volume) {
+VolumeSampler::VolumeSampler(const Volume& volume, double scale, double offset)
+    : volume_(&volume), scale_(scale), offset_(offset) {
   Eigen::Matrix3d D;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) D(r, c) = volume.direction[3 * r + c];
@@ -49,7 +50,7 @@ float VolumeSampler::value_at_index(const Eigen::Vector3d& idx) const {
   const double c00 = c000 + fx * (c100 - c000), c10 = c010 + fx * (c110 - c010);
   const double c01 = c001 + fx * (c101 - c001), c11 = c011 + fx * (c111 - c011);
   const double c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
-  return static_cast<float>(c0 + fz * (c1 - c0));
+  return static_cast<float>(scale_ * (c0 + fz * (c1 - c0)) + offset_);
 }
 
 float VolumeSampler::value_and_gradient(const Eigen::Vector3d& p, Eigen::Vector3d& gradient) const {
@@ -79,8 +80,8 @@ float VolumeSampler::value_and_gradient(const Eigen::Vector3d& p, Eigen::Vector3
   }
   g_idx.y() = inside_axis(idx.y(), ny_) ? (c10 - c00) + fz * ((c11 - c01) - (c10 - c00)) : 0.0;
   g_idx.z() = inside_axis(idx.z(), nz_) ? c1 - c0 : 0.0;
-  gradient = index_gradient_to_physical_ * g_idx;
-  return static_cast<float>(c0 + fz * (c1 - c0));
+  gradient = scale_ * (index_gradient_to_physical_ * g_idx);
+  return static_cast<float>(scale_ * (c0 + fz * (c1 - c0)) + offset_);
 }
 
 bool VolumeSampler::inside(const Eigen::Vector3d& p) const {

@@ -13,8 +13,10 @@ namespace mrsnake {
 /// (clamped coordinates), so a search that leaves the image sees a flat profile.
 class VolumeSampler {
  public:
+  /// Samples are returned as scale·v + offset (an intensity normalization applied on the
+  /// fly, so a large image need not be copied).
   /// \pre volume.data.size() == volume.num_voxels() and every size >= 1.
-  explicit VolumeSampler(const Volume& volume);
+  explicit VolumeSampler(const Volume& volume, double scale = 1.0, double offset = 0.0);
 
   /// Continuous voxel index of a physical point.
   Eigen::Vector3d to_index(const Eigen::Vector3d& p) const { return A_ * p + b_; }
@@ -40,6 +42,7 @@ class VolumeSampler {
   Eigen::Vector3d b_;
   Eigen::Matrix3d index_gradient_to_physical_;  ///< direction·diag(1/spacing)
   long nx_, ny_, nz_;
+  double scale_ = 1.0, offset_ = 0.0;
 };
 
 }  // namespace mrsnake

@@ -137,16 +137,37 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
 
   // Image side: robust normalization and the pyramid.
   report(progress, "normalize", 0.0);
-  Volume normalized = image;
-  result.window = normalize_intensities(normalized);
+  // The full-resolution image is not copied: its sampler normalizes on the fly, and only
+  // the (8× smaller and below) pyramid levels are stored normalized.
+  result.window = robust_intensity_window(image);
+  const double norm_scale = 1.0 / (result.window.high - result.window.low);
+  const double norm_offset = -result.window.low * norm_scale;
   end_stage("normalize");
   report(progress, "pyramid", 0.0);
-  std::vector<Volume> pyramid = build_pyramid(normalized, 8);
+  std::vector<Volume> owned;  // levels 1.. (level 0 too when the image is too small for a pyramid)
+  owned.reserve(8);
+  std::vector<const Volume*> pyramid{&image};
+  while (pyramid.size() < 8) {
+    bool ok = true;
+    for (int a = 0; a < 3; ++a)
+      if (pyramid.back()->size[a] > 1 && (pyramid.back()->size[a] + 1) / 2 < 16) ok = false;
+    if (!ok) break;
+    owned.push_back(downsample_by_two(*pyramid.back()));
+    if (pyramid.size() == 1) apply_intensity_window(owned.back(), result.window);
+    pyramid.push_back(&owned.back());
+  }
+  if (pyramid.size() == 1) {  // a tiny image: normalize a copy
+    owned.push_back(image);
+    apply_intensity_window(owned.back(), result.window);
+    pyramid[0] = &owned.back();
+  }
+  const bool level0_raw = pyramid[0] == &image;
   std::vector<double> spacings;
-  for (const Volume& v : pyramid) spacings.push_back(max_spacing(v));
+  for (const Volume* v : pyramid) spacings.push_back(max_spacing(*v));
   std::vector<VolumeSampler> samplers;
   samplers.reserve(pyramid.size());
-  for (const Volume& v : pyramid) samplers.emplace_back(v);
+  for (std::size_t k = 0; k < pyramid.size(); ++k)
+    samplers.emplace_back(*pyramid[k], k == 0 && level0_raw ? norm_scale : 1.0, k == 0 && level0_raw ? norm_offset : 0.0);
   end_stage("pyramid");
 
   // Which pyramid level each mesh level runs on, and its search.
@@ -197,7 +218,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
                      0.7 * (model.appearance->region.inside - model.appearance->region.outside);
       mo.bright_object = model.appearance->region.inside > model.appearance->region.outside;
     }
-    pose = moments_alignment(pyramid[p], TriMesh{model.levels[jm], model.faces(jm)}, mo);
+    pose = moments_alignment(*pyramid[p], TriMesh{model.levels[jm], model.faces(jm)}, mo);
     V = pose.apply(V);
   }
   // Start hypotheses for the fit: the pose found, and the same without its rotation about
@@ -216,8 +237,12 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     // Two classes near the surface, at full resolution: independent of how well the
     // surface is placed, so a poor start cannot teach the force the wrong contrast.
     std::array<long, 3> lo{}, hi{};
-    mesh_index_box(pyramid[0], W, 0.15, lo, hi);
-    const ThresholdClasses c = threshold_classes(pyramid[0], pyramid[std::min<std::size_t>(1, pyramid.size() - 1)], lo, hi);
+    mesh_index_box(*pyramid[0], W, 0.15, lo, hi);
+    ThresholdClasses c = threshold_classes(*pyramid[0], *pyramid[std::min<std::size_t>(1, pyramid.size() - 1)], lo, hi);
+    if (level0_raw) {  // the medians come from the raw full-resolution image
+      c.upper_median = norm_scale * c.upper_median + norm_offset;
+      c.lower_median = norm_scale * c.lower_median + norm_offset;
+    }
     const bool bright = !model.appearance || model.appearance->region.inside >= model.appearance->region.outside;
     return bright ? RegionStats{c.upper_median, c.lower_median} : RegionStats{c.lower_median, c.upper_median};
   };
