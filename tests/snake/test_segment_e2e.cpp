@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <filesystem>
 #include <cstdio>
 
 #include "mesh/distance.h"
@@ -100,7 +101,7 @@ CaseOutcome run_case(SynthShape shape, std::uint64_t target_seed, std::uint64_t 
     for (const auto& l : r.levels) std::printf("  level %d volume ratio %.4f\n", l.level, enclosed_volume(l.surface) / enclosed_volume(target.truth_mesh));
     std::printf("vertex-to-truth: mean %.3f max %.3f, >1mm: %d of %d\n", d.mean(), d.maxCoeff(), over1, int(d.size()));
     const std::string dir = std::string("/tmp/e2e_") + to_string(shape);
-    std::system(("mkdir -p " + dir).c_str());
+    std::filesystem::create_directories(dir);
     write_mesh(dir + "/final.vtp", r.surface);
     write_mesh(dir + "/truth.vtp", target.truth_mesh);
     write_mesh(dir + "/model.vtp", TriMesh{model.levels.back(), model.faces(model.finest_level())});
