@@ -34,6 +34,10 @@ void add_info_command(CLI::App& app);
 void add_model_info_command(CLI::App& app);
 void add_quality_command(CLI::App& app);
 void add_mc_command(CLI::App& app);
+void add_synth_command(CLI::App& app);
+void add_evaluate_command(CLI::App& app);
+void add_remesh_command(CLI::App& app);
+void add_build_model_command(CLI::App& app);
 void add_segment_command(CLI::App& app);
 
 }  // namespace mrsnake::cli

@@ -15,6 +15,7 @@ void add_mc_command(CLI::App& app) {
     std::string labels, output;
     int label = 1;
     int smooth = 0;
+    int close_tunnels = 0;
     bool json = false;
   };
   auto a = std::make_shared<Args>();
@@ -23,6 +24,9 @@ void add_mc_command(CLI::App& app) {
   cmd->add_option("-o,--output", a->output, "Output mesh (.vtp .vtk .stl .ply .obj .off)")->required();
   cmd->add_option("--smooth", a->smooth, "Windowed-sinc smoothing iterations (volume-preserving); 0 = none")
       ->check(CLI::Range(0, 1000));
+  cmd->add_option("--close-tunnels", a->close_tunnels,
+                  "If the surface is not genus 0, close the label with radii up to this many voxels until it is")
+      ->check(CLI::Range(0, 20));
   cmd->add_flag("--json", a->json, "Print a JSON summary");
   cmd->footer("Example: mrsnake mc --labels liver-labels.nii.gz --label 255 --smooth 20 -o liver.vtp");
   cmd->callback([a] {
@@ -31,6 +35,7 @@ void add_mc_command(CLI::App& app) {
     const Volume labels = read_volume(a->labels);
     LabelSurfaceOptions options;
     options.smoothing_iterations = a->smooth;
+    options.max_closing_radius = a->close_tunnels;
     const LabelSurface surface = extract_label_surface(labels, a->label, options, progress);
     if (!surface.dropped_component_faces.empty()) {
       // Components are sorted largest first: the first few sizes say enough.
@@ -43,6 +48,9 @@ void add_mc_command(CLI::App& app) {
            " connected surfaces; kept the largest and dropped " + std::to_string(surface.dropped_component_faces.size()) +
            " (largest dropped, in faces: " + sizes + ")");
     }
+    if (surface.closing_radius > 0)
+      warn("label " + std::to_string(a->label) + " had a genus-" + std::to_string(surface.genus_before_repair) +
+           " surface; closed its tunnels with a radius of " + std::to_string(surface.closing_radius) + " voxels");
     write_mesh(a->output, surface.mesh);
     const TopologyReport topo = topology_report(surface.mesh);
     const double voxel_volume = labels.spacing[0] * labels.spacing[1] * labels.spacing[2];
@@ -54,6 +62,8 @@ void add_mc_command(CLI::App& app) {
                   {"vertices", surface.mesh.num_vertices()},
                   {"faces", surface.mesh.num_faces()},
                   {"components_found", surface.components_found},
+                  {"genus_before_repair", surface.genus_before_repair},
+                  {"closing_radius_voxels", surface.closing_radius},
                   {"topology", topo},
                   {"enclosed_volume_mm3", enclosed_volume(surface.mesh)},
                   {"label_volume_mm3", static_cast<double>(count) * voxel_volume}});

@@ -71,8 +71,16 @@ void add_model_info_command(CLI::App& app) {
         std::printf("\n");
       }
       std::fflush(stdout);
-      if (!model.remesh_quality.is_null())
-        std::cout << "  remesh quality    " << model.remesh_quality.dump() << '\n';
+      if (!model.remesh_quality.is_null()) {
+        // The finest level's quality (mesh/quality.h keys), the rest is in model.json.
+        const nlohmann::json& q = model.remesh_quality.contains("finest_level_quality")
+                                      ? model.remesh_quality["finest_level_quality"]
+                                      : model.remesh_quality;
+        std::cout << "  remesh quality   ";
+        for (const char* key : {"min_angle_deg", "q_min", "q_mean", "pct_valence6_interior", "edge_length_cv"})
+          if (q.contains(key) && q[key].is_number()) std::cout << ' ' << key << ' ' << format("%.3g", q[key].get<double>());
+        std::cout << '\n';
+      }
       if (!model.timings.empty()) {
         std::cout << "  timings (s)      ";
         for (const auto& [stage, s] : model.timings) std::cout << ' ' << stage << ' ' << format("%.3f", s);

@@ -9,6 +9,7 @@
 #include "mesh/errors.h"
 #include "mesh/image_io.h"
 #include "mesh/mesh_io.h"
+#include "mesh/topology.h"
 #include "snake/synth.h"
 
 namespace mrsnake::cli {
@@ -79,7 +80,7 @@ void add_synth_command(CLI::App& app) {
   cmd->add_option("--deform", a->deform, "Largest displacement in mm of a random smooth deformation (0: none)")->capture_default_str();
   cmd->add_option("--seed", a->seed, "Random seed: the same seed gives the same case")->capture_default_str();
   cmd->add_option("--supersampling", a->supersampling, "Partial volume: N^3 samples per boundary voxel")->capture_default_str();
-  auto* from_image = cmd->add_option("--from-image", a->from_image, "Warp this real image instead of rendering a shape");
+  auto* from_image = cmd->add_option("--from-image", a->from_image, "Warp this real image instead of rendering a shape (adds no noise or blur unless --noise, --snr or --blur is given)");
   auto* from_labels = cmd->add_option("--from-labels", a->from_labels, "The label volume of --from-image");
   cmd->add_option("--label", a->label, "The label of --from-labels that becomes the truth")->capture_default_str();
   auto* params = cmd->add_option("--params", a->params, "Regenerate the case recorded in this params.json");
@@ -96,6 +97,11 @@ void add_synth_command(CLI::App& app) {
     SynthParams params;
     Volume source_image, source_labels;
     if (!a->params.empty()) {
+      for (const char* option : {"--shape", "--size", "--spacing", "--noise", "--snr", "--blur", "--bias", "--contrast", "--pose",
+                                 "--deform", "--seed", "--supersampling", "--label"})
+        if (cmd->count(option) > 0)
+          throw CLI::ValidationError(option, "--params regenerates the recorded case as it was; drop " + std::string(option) +
+                                                 " or drop --params");
       params = synth_params_from_json(read_json_file(a->params));
     } else {
       SynthOptions o;
@@ -124,6 +130,9 @@ void add_synth_command(CLI::App& app) {
         o.foreground = fb[0];
         o.background = fb[1];
       } else {
+        for (const char* option : {"--shape", "--size", "--spacing", "--contrast", "--supersampling"})
+          if (cmd->count(option) > 0)
+            throw CLI::ValidationError(option, std::string(option) + " does not apply to --from-image, which keeps the grid and intensities of the image");
         // A real image already has its noise and blur: add none unless asked.
         if (cmd->count("--noise") == 0 && cmd->count("--snr") == 0) o.noise = SynthNoise::none;
         if (cmd->count("--blur") == 0) o.blur_mm = 0;
@@ -151,6 +160,9 @@ void add_synth_command(CLI::App& app) {
     write_volume(image_path, r.image, VoxelType::float32);
     write_volume(truth_path, r.truth, VoxelType::uint8);
     write_mesh(mesh_path, r.truth_mesh);
+    const TopologyReport topology = topology_report(r.truth_mesh);
+    if (!topology.is_closed_genus0())
+      warn("the truth surface is " + topology.describe() + " (the label has several parts or holes)");
     nlohmann::json pj = params;
     write_text_file_atomically(params_path, pj.dump(2) + "\n");
 

@@ -24,6 +24,10 @@ int main(int argc, char** argv) {
   cli::add_model_info_command(app);
   cli::add_quality_command(app);
   cli::add_mc_command(app);
+  cli::add_synth_command(app);
+  cli::add_evaluate_command(app);
+  cli::add_remesh_command(app);
+  cli::add_build_model_command(app);
   cli::add_segment_command(app);
 
   try {

@@ -13,7 +13,7 @@ find_package(VTK REQUIRED COMPONENTS
 find_package(ITK 5.2 REQUIRED COMPONENTS
   ITKCommon ITKIOImageBase ITKIONIFTI ITKIONRRD ITKIOMeta ITKIOGIPL ITKIOGDCM
   ITKImageIntensity ITKImageFilterBase ITKThresholding ITKSmoothing ITKImageGrid
-  ITKDistanceMap ITKLevelSets ITKImageGradient ITKRegistrationCommon ITKTransform
+  ITKBinaryMathematicalMorphology ITKLabelMap ITKDistanceMap ITKLevelSets ITKImageGradient ITKRegistrationCommon ITKTransform
   ITKImageFunction ITKStatistics ITKOptimizers ITKImageCompare)
 find_package(CLI11 CONFIG QUIET)
 find_package(nlohmann_json 3.10 REQUIRED)

@@ -10,6 +10,7 @@
 #include <set>
 
 #include "mesh/errors.h"
+#include "mesh/label_repair.h"
 #include "mesh/topology.h"
 #include "mesh/vtk_convert.h"
 
@@ -77,13 +78,11 @@ double enclosed_volume(const TriMesh& mesh) {
   return six_v / 6.0;
 }
 
-LabelSurface extract_label_surface(const Volume& labels, int label, const LabelSurfaceOptions& options,
-                                   const ProgressFn& progress) {
+namespace {
+
+LabelSurface extract_once(const Volume& labels, int label, const LabelSurfaceOptions& options,
+                          const ProgressFn& progress) {
   const auto target = static_cast<float>(label);
-  if (std::none_of(labels.data.begin(), labels.data.end(), [&](float v) { return v == target; }))
-    throw InputError("label " + std::to_string(label) + " is not present in the volume (labels present: " +
-                     labels_present(labels) + "); choose one of those with --label");
-  report(progress, "marching cubes", 0.0);
   // Pad with a value that is not the label, so that objects touching the border close.
   const float outside = target == 0.0f ? 1.0f : 0.0f;
   vtkNew<vtkDiscreteFlyingEdges3D> mc;
@@ -113,8 +112,32 @@ LabelSurface extract_label_surface(const Volume& labels, int label, const LabelS
     report(progress, "smoothing", 0.0);
     mesh = windowed_sinc(mesh, options.smoothing_iterations, options.smoothing_passband);
   }
-  report(progress, "marching cubes", 1.0);
   result.mesh = std::move(mesh);
+  return result;
+}
+
+}  // namespace
+
+LabelSurface extract_label_surface(const Volume& labels, int label, const LabelSurfaceOptions& options,
+                                   const ProgressFn& progress) {
+  const auto target = static_cast<float>(label);
+  if (std::none_of(labels.data.begin(), labels.data.end(), [&](float v) { return v == target; }))
+    throw InputError("label " + std::to_string(label) + " is not present in the volume (labels present: " +
+                     labels_present(labels) + "); choose one of those with --label");
+  report(progress, "marching cubes", 0.0);
+  LabelSurface result = extract_once(labels, label, options, progress);
+  result.genus_before_repair = topology_report(result.mesh).genus;
+  for (int radius = 1; result.genus_before_repair > 0 && radius <= options.max_closing_radius; ++radius) {
+    report(progress, "closing tunnels (radius " + std::to_string(radius) + ")", 0.0);
+    LabelSurface closed = extract_once(close_label(labels, label, radius), 1, options, progress);
+    if (topology_report(closed.mesh).genus == 0) {
+      closed.genus_before_repair = result.genus_before_repair;
+      closed.closing_radius = radius;
+      result = std::move(closed);
+      break;
+    }
+  }
+  report(progress, "marching cubes", 1.0);
   return result;
 }
 

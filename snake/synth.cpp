@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <functional>
 #include <limits>
 #include <random>
 #include <sstream>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -231,7 +233,7 @@ DeformationParams draw_deformation(double amplitude, const Eigen::Vector3d& lo, 
     u.centres.push_back(c);
     u.displacements.push_back(rng.in_ball(1.0));
   }
-  const int n = 20;
+  const int n = 32;  // samples per axis of the box: under a third of the bump width apart
   auto sample = [&](int i, int j, int k) {
     return Eigen::Vector3d(box_lo.x() + (box_hi.x() - box_lo.x()) * i / (n - 1), box_lo.y() + (box_hi.y() - box_lo.y()) * j / (n - 1),
                            box_lo.z() + (box_hi.z() - box_lo.z()) * k / (n - 1));
@@ -241,7 +243,8 @@ DeformationParams draw_deformation(double amplitude, const Eigen::Vector3d& lo, 
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) largest = std::max(largest, u.displacement(sample(i, j, k)).norm());
   for (auto& d : u.displacements) d *= amplitude / std::max(largest, 1e-12);
-  // p -> p + u(p) is the identity far away; positive Jacobians make it a diffeomorphism.
+  // p -> p + u(p) is the identity far away; with positive Jacobians everywhere it is a
+  // diffeomorphism. They are checked on the samples and at the bump centres, with a margin.
   double smallest_det = std::numeric_limits<double>::infinity();
   for (int k = 0; k < n; ++k)
     for (int j = 0; j < n; ++j)
@@ -299,27 +302,50 @@ void degrade(Volume& image, const SynthParams& p, double contrast, const Progres
   }
 }
 
+/// Runs f(begin, end, is_first) on contiguous ranges of [0, n), one per hardware thread,
+/// and rethrows the first exception.
+void parallel_ranges(std::size_t n, const std::function<void(std::size_t, std::size_t, bool)>& f) {
+  const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 8);
+  const std::size_t parts = std::max<std::size_t>(1, std::min(threads, n / 4));
+  if (parts == 1) return f(0, n, true);
+  std::vector<std::exception_ptr> errors(parts);
+  std::vector<std::thread> pool;
+  for (std::size_t t = 0; t < parts; ++t)
+    pool.emplace_back([&, t] {
+      try {
+        f(n * t / parts, n * (t + 1) / parts, t == 0);
+      } catch (...) {
+        errors[t] = std::current_exception();
+      }
+    });
+  for (auto& th : pool) th.join();
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
 /// Moves each vertex onto the zero level of f by Newton steps along the gradient.
 void project_onto_surface(RowMatrixX3d& V, const std::function<double(const Eigen::Vector3d&)>& f, double h, double max_step) {
-  for (int v = 0; v < V.rows(); ++v) {
-    Eigen::Vector3d x = V.row(v).transpose();
-    for (int it = 0; it < 10; ++it) {
-      const double fx = f(x);
-      if (std::abs(fx) < 1e-9) break;
-      Eigen::Vector3d g;
-      for (int d = 0; d < 3; ++d) {
-        Eigen::Vector3d e = Eigen::Vector3d::Zero();
-        e[d] = h;
-        g[d] = (f(x + e) - f(x - e)) / (2 * h);
+  parallel_ranges(static_cast<std::size_t>(V.rows()), [&](std::size_t begin, std::size_t end, bool) {
+    for (int v = static_cast<int>(begin); v < static_cast<int>(end); ++v) {
+      Eigen::Vector3d x = V.row(v).transpose();
+      for (int it = 0; it < 10; ++it) {
+        const double fx = f(x);
+        if (std::abs(fx) < 1e-9) break;
+        Eigen::Vector3d g;
+        for (int d = 0; d < 3; ++d) {
+          Eigen::Vector3d e = Eigen::Vector3d::Zero();
+          e[d] = h;
+          g[d] = (f(x + e) - f(x - e)) / (2 * h);
+        }
+        const double g2 = g.squaredNorm();
+        if (g2 < 1e-12) break;
+        Eigen::Vector3d step = fx * g / g2;
+        if (step.norm() > max_step) step *= max_step / step.norm();
+        x -= step;
       }
-      const double g2 = g.squaredNorm();
-      if (g2 < 1e-12) break;
-      Eigen::Vector3d step = fx * g / g2;
-      if (step.norm() > max_step) step *= max_step / step.norm();
-      x -= step;
+      V.row(v) = x.transpose();
     }
-    V.row(v) = x.transpose();
-  }
+  });
 }
 
 }  // namespace
@@ -474,11 +500,16 @@ SynthResult render_synth(const SynthParams& params, const ProgressFn& progress) 
   const bool heart = params.shape.kind == SynthShape::heart;
   const double s = params.pose.scale;
   auto object = [&](const Eigen::Vector3d& p) { return s * shape_function(params.shape, params.to_reference(p)); };
-  auto outer = [&](const Eigen::Vector3d& p) { return s * heart_outer_function(params.shape, params.to_reference(p)); };
+  // The object's and (heart) the outer wall's functions, sharing one mapping of the point.
+  auto both = [&](const Eigen::Vector3d& p) {
+    const Eigen::Vector3d x = params.to_reference(p);
+    return std::pair<double, double>(s * shape_function(params.shape, x), heart ? s * heart_outer_function(params.shape, x) : 1.0);
+  };
   const double mid = 0.5 * (o.foreground + o.background);
   auto tissue = [&](const Eigen::Vector3d& p) {
-    if (object(p) < 0) return o.foreground;
-    if (heart) return outer(p) < 0 ? o.background : mid;
+    const auto [v, w] = both(p);
+    if (v < 0) return o.foreground;
+    if (heart) return w < 0 ? o.background : mid;
     return o.background;
   };
 
@@ -493,14 +524,13 @@ SynthResult render_synth(const SynthParams& params, const ProgressFn& progress) 
 
   // Values at voxel corners, one z plane at a time (plane k holds the corners at k − 1/2).
   const std::size_t cx = nx + 1, cy = ny + 1;
-  std::vector<double> obj_lo(cx * cy), obj_hi(cx * cy), out_lo, out_hi;
-  if (heart) out_lo.resize(cx * cy), out_hi.resize(cx * cy);
   auto fill_plane = [&](double kz, std::vector<double>& obj, std::vector<double>& out) {
     for (std::size_t j = 0; j < cy; ++j)
       for (std::size_t i = 0; i < cx; ++i) {
         const Eigen::Vector3d c = voxel_centre(r.truth, i - 0.5, j - 0.5, kz);
-        obj[i + cx * j] = object(c);
-        if (heart) out[i + cx * j] = outer(c);
+        const auto [v, w] = both(c);
+        obj[i + cx * j] = v;
+        if (heart) out[i + cx * j] = w;
       }
   };
   auto is_mixed = [&](const std::vector<double>& lo, const std::vector<double>& hi, double centre_value, std::size_t i,
@@ -517,40 +547,45 @@ SynthResult render_synth(const SynthParams& params, const ProgressFn& progress) 
         }
     return (neg && pos) || smallest < margin;
   };
-
-  fill_plane(-0.5, obj_lo, out_lo);
-  for (std::size_t k = 0; k < nz; ++k) {
-    report(progress, "synth: shape", static_cast<double>(k) / nz);
-    fill_plane(k + 0.5, obj_hi, out_hi);
-    for (std::size_t j = 0; j < ny; ++j)
-      for (std::size_t i = 0; i < nx; ++i) {
-        const Eigen::Vector3d c = voxel_centre(r.truth, i, j, k);
-        const double v = object(c);
-        const double w = heart ? outer(c) : 1.0;
-        const bool border = i < 2 || j < 2 || k < 2 || i + 2 >= nx || j + 2 >= ny || k + 2 >= nz;
-        if (border && v <= 0)
-          throw InputError("the " + to_string(params.shape.kind) +
-                           " does not fit inside the image (it reaches the border); use a larger --size or --spacing, "
-                           "a smaller --deform, or another --seed");
-        field.at(i, j, k) = static_cast<float>(v);
-        r.truth.at(i, j, k) = v < 0 ? kTruthLabel : (heart && w < 0 ? kWallLabel : 0);
-        const bool mixed = is_mixed(obj_lo, obj_hi, v, i, j) || (heart && is_mixed(out_lo, out_hi, w, i, j));
-        double value;
-        if (!mixed) {
-          value = v < 0 ? o.foreground : (heart ? (w < 0 ? o.background : mid) : o.background);
-        } else {  // partial volume: the mean intensity over n³ sub-voxel samples
-          double sum = 0;
-          for (int a = 0; a < n; ++a)
-            for (int b = 0; b < n; ++b)
-              for (int e = 0; e < n; ++e)
-                sum += tissue(voxel_centre(r.truth, i + (e + 0.5) / n - 0.5, j + (b + 0.5) / n - 0.5, k + (a + 0.5) / n - 0.5));
-          value = sum / (n * n * n);
+  // Slabs of z planes, one per thread; every voxel depends on the parameters only, so the
+  // result does not depend on the number of threads.
+  auto render_slab = [&](std::size_t k0, std::size_t k1, bool reports) {
+    std::vector<double> obj_lo(cx * cy), obj_hi(cx * cy), out_lo, out_hi;
+    if (heart) out_lo.resize(cx * cy), out_hi.resize(cx * cy);
+    fill_plane(k0 - 0.5, obj_lo, out_lo);
+    for (std::size_t k = k0; k < k1; ++k) {
+      if (reports) report(progress, "synth: shape", static_cast<double>(k - k0) / (k1 - k0));
+      fill_plane(k + 0.5, obj_hi, out_hi);
+      for (std::size_t j = 0; j < ny; ++j)
+        for (std::size_t i = 0; i < nx; ++i) {
+          const Eigen::Vector3d c = voxel_centre(r.truth, i, j, k);
+          const auto [v, w] = both(c);
+          const bool border = i < 2 || j < 2 || k < 2 || i + 2 >= nx || j + 2 >= ny || k + 2 >= nz;
+          if (border && v <= 0)
+            throw InputError("the " + to_string(params.shape.kind) +
+                             " does not fit inside the image (it reaches the border); use a larger --size or --spacing, "
+                             "a smaller --deform, or another --seed");
+          field.at(i, j, k) = static_cast<float>(v);
+          r.truth.at(i, j, k) = v < 0 ? kTruthLabel : (heart && w < 0 ? kWallLabel : 0);
+          const bool mixed = is_mixed(obj_lo, obj_hi, v, i, j) || (heart && is_mixed(out_lo, out_hi, w, i, j));
+          double value;
+          if (!mixed) {
+            value = v < 0 ? o.foreground : (heart ? (w < 0 ? o.background : mid) : o.background);
+          } else {  // partial volume: the mean intensity over n³ sub-voxel samples
+            double sum = 0;
+            for (int a = 0; a < n; ++a)
+              for (int b = 0; b < n; ++b)
+                for (int e = 0; e < n; ++e)
+                  sum += tissue(voxel_centre(r.truth, i + (e + 0.5) / n - 0.5, j + (b + 0.5) / n - 0.5, k + (a + 0.5) / n - 0.5));
+            value = sum / (n * n * n);
+          }
+          r.image.at(i, j, k) = static_cast<float>(value);
         }
-        r.image.at(i, j, k) = static_cast<float>(value);
-      }
-    std::swap(obj_lo, obj_hi);
-    if (heart) std::swap(out_lo, out_hi);
-  }
+      std::swap(obj_lo, obj_hi);
+      if (heart) std::swap(out_lo, out_hi);
+    }
+  };
+  parallel_ranges(nz, [&](std::size_t k0, std::size_t k1, bool first) { render_slab(k0, k1, first); });
   report(progress, "synth: shape", 1.0);
 
   degrade(r.image, params, o.foreground - o.background, progress);

@@ -356,7 +356,6 @@ RowMatrixX3d WaveletTransform::synthesize_level(int j, const RowMatrixX3d& coars
     for (int i = 0; i < m; ++i) d.row(i) = to_global(f[i], details.row(i).transpose()).transpose();
   }
   RowMatrixX3d fine(level.n_fine, 3);
-  fine.topRows(level.n_coarse) = coarse;
   RowMatrixX3d even = coarse;
   if (options_.update) update(j, even, d, -1.0);
   fine.topRows(level.n_coarse) = even;

@@ -120,8 +120,8 @@ class WaveletTransform {
   /// The prediction stencil of new vertex v (n_j <= v < n_{j+1}) of level j+1.
   PredictStencil predict_stencil(int j, int v) const;
 
-  /// The frames of the new vertices of level j+1, computed from S_j (n_j rows), and the
-  /// reference length used for the fallback (the mean edge length of S_j).
+  /// The frames of the new vertices of level j+1, computed from S_j (n_j rows) only; the
+  /// fallback's reference length is the mean edge length of S_j.
   std::vector<LocalFrame> frames(int j, const RowMatrixX3d& coarse) const;
 
  private:

@@ -20,6 +20,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <string>
 
 #include "mesh/errors.h"
 #include "mesh/vtk_convert.h"
@@ -27,18 +28,18 @@
 namespace mrsnake::report {
 
 bool display_available(std::string* why) {
-  const char* name = std::getenv("DISPLAY");
-  if (!name || !*name) {
-    if (why) *why = "no DISPLAY is set (run under xvfb-run -a for 3D pictures)";
-    return false;
-  }
-  Display* display = XOpenDisplay(nullptr);
-  if (!display) {
-    if (why) *why = std::string("the X display '") + name + "' does not answer";
-    return false;
-  }
-  XCloseDisplay(display);
-  return true;
+  // Probed once per process: the answer does not change, and repeated connections to a
+  // busy Xvfb have been seen to fail.
+  static const std::string problem = [] {
+    const char* name = std::getenv("DISPLAY");
+    if (!name || !*name) return std::string("no DISPLAY is set (run under xvfb-run -a for 3D pictures)");
+    Display* display = XOpenDisplay(nullptr);
+    if (!display) return std::string("the X display '") + name + "' does not answer";
+    XCloseDisplay(display);
+    return std::string();
+  }();
+  if (why) *why = problem;
+  return problem.empty();
 }
 
 std::vector<std::uint8_t> render_mesh_png(const TriMesh& mesh, const RenderOptions& options) {

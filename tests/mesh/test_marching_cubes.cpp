@@ -168,3 +168,30 @@ TEST(McCommand, LiverIsOneClosedGenusZeroSurface) {
   EXPECT_TRUE(topo.is_closed_genus0()) << topo.describe();
   EXPECT_GT(s.mesh.num_faces(), 10000);
 }
+
+TEST(MarchingCubes, ClosingRepairsATunnelOnlyWhenAsked) {
+  // A torus (major radius 9, minor 5.5): its hole has radius 3.5 voxels.
+  Volume labels = grid(40, {1, 1, 1});
+  labels.data.assign(labels.num_voxels(), 0.f);
+  for (std::size_t k = 0; k < 40; ++k)
+    for (std::size_t j = 0; j < 40; ++j)
+      for (std::size_t i = 0; i < 40; ++i) {
+        const double x = i - 19.5, y = j - 19.5, z = k - 19.5;
+        const double ring = std::hypot(x, y) - 9.0;
+        if (ring * ring + z * z <= 5.5 * 5.5) labels.at(i, j, k) = 4.f;
+      }
+  const LabelSurface plain = extract_label_surface(labels, 4);
+  EXPECT_EQ(topology_report(plain.mesh).genus, 1);
+  EXPECT_EQ(plain.closing_radius, 0);
+
+  LabelSurfaceOptions options;
+  options.max_closing_radius = 6;
+  const LabelSurface repaired = extract_label_surface(labels, 4, options);
+  EXPECT_TRUE(topology_report(repaired.mesh).is_closed_genus0());
+  EXPECT_EQ(repaired.genus_before_repair, 1);
+  EXPECT_GE(repaired.closing_radius, 1);
+  EXPECT_LE(repaired.closing_radius, 6);
+  // The repair fills the hole but keeps the outside: the volume only grows, and not by much.
+  EXPECT_GT(enclosed_volume(repaired.mesh), enclosed_volume(plain.mesh));
+  EXPECT_LT(enclosed_volume(repaired.mesh), 1.3 * enclosed_volume(plain.mesh));
+}

@@ -1,0 +1,174 @@
+#include "remesh/base_mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+
+#include "mesh/errors.h"
+#include "remesh/convex_hull.h"
+
+namespace mrsnake {
+namespace {
+
+// Farthest point sampling in 3D over the candidates, continuing from the distances already
+// in `dist` (0 for chosen vertices).
+void farthest_points(const RowMatrixX3d& X, const std::vector<int>& candidates, int count, std::vector<double>& dist,
+                     std::vector<int>& chosen) {
+  for (int k = 0; k < count; ++k) {
+    int best = -1;
+    double best_d = -1;
+    for (int v : candidates)
+      if (dist[v] > best_d) {
+        best_d = dist[v];
+        best = v;
+      }
+    if (best < 0 || best_d <= 0) break;
+    chosen.push_back(best);
+    for (int v = 0; v < X.rows(); ++v) dist[v] = std::min(dist[v], (X.row(v) - X.row(best)).squaredNorm());
+  }
+}
+
+}  // namespace
+
+int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F) {
+  const int n = static_cast<int>(D.rows());
+  int flips = 0;
+  for (int pass = 0; pass < 50; ++pass) {
+    std::map<std::pair<int, int>, std::pair<int, int>> edge_faces;  // directed edge -> (face, corner opposite)
+    std::vector<int> valence(n, 0);
+    for (int f = 0; f < F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) edge_faces[{F(f, k), F(f, (k + 1) % 3)}] = {f, (k + 2) % 3};
+    std::vector<bool> boundary(n, false);
+    for (const auto& [e, fc] : edge_faces) {
+      ++valence[e.first];
+      if (!edge_faces.count({e.second, e.first})) boundary[e.first] = boundary[e.second] = true;
+    }
+    // valence[] counted outgoing half-edges; add the incoming boundary ones.
+    for (const auto& [e, fc] : edge_faces)
+      if (!edge_faces.count({e.second, e.first})) ++valence[e.second];
+    auto target = [&](int v) { return boundary[v] ? 4 : 6; };
+    bool changed = false;
+    std::vector<bool> touched(F.rows(), false);
+    std::set<std::pair<int, int>> created;
+    for (const auto& [e, fc] : edge_faces) {
+      const int a = e.first, b = e.second;
+      if (a > b) continue;
+      const auto twin = edge_faces.find({b, a});
+      if (twin == edge_faces.end()) continue;
+      const int f1 = fc.first, f2 = twin->second.first;
+      if (touched[f1] || touched[f2]) continue;
+      const int c = F(f1, fc.second), d = F(f2, twin->second.second);
+      if (c == d || edge_faces.count({c, d}) || edge_faces.count({d, c}) || created.count({std::min(c, d), std::max(c, d)}))
+        continue;
+      if (valence[a] <= 3 || valence[b] <= 3) continue;
+      auto dev = [&](int v, int delta) { const double x = valence[v] + delta - target(v); return x * x; };
+      const double before = dev(a, 0) + dev(b, 0) + dev(c, 0) + dev(d, 0);
+      const double after = dev(a, -1) + dev(b, -1) + dev(c, 1) + dev(d, 1);
+      if (!(after < before)) continue;
+      // f1 = (a, b, c), f2 = (b, a, d): the quad is a, d, b, c counter-clockwise.
+      if (!(domain_orientation(D.row(a), D.row(d), D.row(c)) > 0) || !(domain_orientation(D.row(d), D.row(b), D.row(c)) > 0))
+        continue;
+      F.row(f1) << a, d, c;
+      F.row(f2) << d, b, c;
+      touched[f1] = touched[f2] = true;
+      created.insert({std::min(c, d), std::max(c, d)});
+      --valence[a];
+      --valence[b];
+      ++valence[c];
+      ++valence[d];
+      ++flips;
+      changed = true;
+    }
+    if (!changed) break;
+  }
+  return flips;
+}
+
+BaseMesh build_base_mesh(const Parameterization& param, int n0) {
+  const TriMesh& mesh = param.surface;
+  const int n = mesh.num_vertices();
+  n0 = std::min(n0, n);
+  BaseMesh base;
+  std::vector<double> dist(n, std::numeric_limits<double>::infinity());
+  std::vector<int> all(n);
+  for (int v = 0; v < n; ++v) all[v] = v;
+  const Eigen::RowVector3d centroid = mesh.V.colwise().mean();
+
+  if (param.kind == DomainKind::disk) {
+    const std::vector<bool> boundary = boundary_vertices(mesh.F, n);
+    std::vector<int> rim;
+    for (int v = 0; v < n; ++v)
+      if (boundary[v]) rim.push_back(v);
+    double area = 0, perimeter = 0;
+    for (int f = 0; f < mesh.num_faces(); ++f) {
+      const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+      area += 0.5 * (b - a).cross(c - a).norm();
+    }
+    // Boundary edges appear once; their total length is the perimeter.
+    std::map<std::pair<int, int>, int> directed;
+    for (int f = 0; f < mesh.num_faces(); ++f)
+      for (int k = 0; k < 3; ++k) directed[{mesh.F(f, k), mesh.F(f, (k + 1) % 3)}] = f;
+    for (const auto& [e, f] : directed)
+      if (!directed.count({e.second, e.first})) perimeter += (mesh.V.row(e.first) - mesh.V.row(e.second)).norm();
+    // Even spacing h over the whole disk: area ~ (n0 - nb/2)·(√3/2)·h², nb ~ perimeter / h.
+    double h = std::sqrt(2 * area / (std::sqrt(3.0) * n0));
+    for (int it = 0; it < 20; ++it) {
+      const double nb = perimeter / h;
+      h = std::sqrt(2 * area / (std::sqrt(3.0) * std::max(1.0, n0 - nb / 2)));
+    }
+    const int nb = std::clamp(static_cast<int>(std::lround(perimeter / h)), 3, std::max(3, n0 - 1));
+    // Start the rim sampling from the rim vertex farthest from the centroid.
+    int first = rim.front();
+    for (int v : rim)
+      if ((mesh.V.row(v) - centroid).squaredNorm() > (mesh.V.row(first) - centroid).squaredNorm()) first = v;
+    base.samples.push_back(first);
+    for (int v = 0; v < n; ++v) dist[v] = (mesh.V.row(v) - mesh.V.row(first)).squaredNorm();
+    farthest_points(mesh.V, rim, nb - 1, dist, base.samples);
+    std::vector<int> inner;
+    for (int v = 0; v < n; ++v)
+      if (!boundary[v]) inner.push_back(v);
+    farthest_points(mesh.V, inner, n0 - static_cast<int>(base.samples.size()), dist, base.samples);
+  } else {
+    int first = 0;
+    for (int v = 0; v < n; ++v)
+      if ((mesh.V.row(v) - centroid).squaredNorm() > (mesh.V.row(first) - centroid).squaredNorm()) first = v;
+    base.samples.push_back(first);
+    for (int v = 0; v < n; ++v) dist[v] = (mesh.V.row(v) - mesh.V.row(first)).squaredNorm();
+    farthest_points(mesh.V, all, n0 - 1, dist, base.samples);
+  }
+
+  const int m = static_cast<int>(base.samples.size());
+  base.domain.resize(m, 3);
+  for (int i = 0; i < m; ++i) base.domain.row(i) = param.domain.row(base.samples[i]);
+
+  if (param.kind == DomainKind::sphere) {
+    base.faces = convex_hull_faces(base.domain);
+  } else {
+    const std::vector<bool> boundary = boundary_vertices(mesh.F, n);
+    RowMatrixX3d lifted(m, 3);
+    for (int i = 0; i < m; ++i) {
+      if (boundary[base.samples[i]]) base.domain.row(i) = project_to_domain(DomainKind::disk, base.domain.row(i), true);
+      lifted.row(i) << base.domain(i, 0), base.domain(i, 1), base.domain(i, 0) * base.domain(i, 0) + base.domain(i, 1) * base.domain(i, 1);
+    }
+    const RowMatrixX3i hull = convex_hull_faces(lifted);
+    std::vector<Eigen::RowVector3i> lower;
+    for (int f = 0; f < hull.rows(); ++f) {
+      const Eigen::Vector3d a = lifted.row(hull(f, 0)), b = lifted.row(hull(f, 1)), c = lifted.row(hull(f, 2));
+      if ((b - a).cross(c - a).z() < 0) lower.emplace_back(hull(f, 0), hull(f, 2), hull(f, 1));
+    }
+    base.faces.resize(static_cast<int>(lower.size()), 3);
+    for (std::size_t i = 0; i < lower.size(); ++i) base.faces.row(static_cast<int>(i)) = lower[i];
+  }
+  std::set<int> used(base.faces.data(), base.faces.data() + base.faces.size());
+  if (static_cast<int>(used.size()) != m)
+    throw AlgorithmError("the base mesh does not use all of its " + std::to_string(m) +
+                         " vertices; the parameterization is too distorted for this base size (try another --faces)");
+  if (const int flipped = count_flipped(base.domain, base.faces); flipped > 0)
+    throw AlgorithmError("the base mesh has " + std::to_string(flipped) + " flipped triangles in the domain");
+  base.valence_flips = flip_toward_regular_valence(base.domain, base.faces);
+  return base;
+}
+
+}  // namespace mrsnake

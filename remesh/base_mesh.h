@@ -1,0 +1,30 @@
+#pragma once
+/// \file base_mesh.h
+/// The base mesh T0 in D: base vertices spread evenly over the surface in 3D (farthest point
+/// sampling), so that protrusions get their own base vertices, triangulated in D by Delaunay
+/// (the convex hull on the sphere, the lifted lower hull in the disk), then edge flips that
+/// bring valences toward 6 (4 on the boundary).
+#include <vector>
+
+#include "mesh/trimesh.h"
+#include "remesh/parameterization.h"
+
+namespace mrsnake {
+
+struct BaseMesh {
+  RowMatrixX3i faces;          ///< F0, counter-clockwise in D
+  RowMatrixX3d domain;         ///< n0 rows: base vertex positions in D
+  std::vector<int> samples;    ///< the vertex of the parameterized surface under each base vertex
+  int valence_flips = 0;       ///< edge flips made to even out valences
+};
+
+/// \pre param comes from parameterize(); n0 >= 6.
+/// \throw AlgorithmError if no valid base triangulation results.
+BaseMesh build_base_mesh(const Parameterization& param, int n0);
+
+/// Flips edges (never boundary edges, never making a flipped triangle in D or a duplicate
+/// edge) while that lowers sum (valence - 6)² (boundary: (valence - 4)²).
+/// \return the number of flips made.
+int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F);
+
+}  // namespace mrsnake

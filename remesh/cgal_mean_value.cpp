@@ -1,0 +1,63 @@
+// CGAL adapter: mean value coordinates parameterization of a disk (the only CGAL
+// parameterization translation unit).
+#include <CGAL/Polygon_mesh_processing/measure.h>
+#include <CGAL/Simple_cartesian.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/Surface_mesh_parameterization/Circular_border_parameterizer_3.h>
+#include <CGAL/Surface_mesh_parameterization/Error_code.h>
+#include <CGAL/Surface_mesh_parameterization/Mean_value_coordinates_parameterizer_3.h>
+#include <CGAL/Surface_mesh_parameterization/parameterize.h>
+#include <CGAL/Eigen_solver_traits.h>
+
+#include <Eigen/SparseLU>
+
+#include <cmath>
+#include <vector>
+
+#include "mesh/errors.h"
+#include "remesh/parameterization.h"
+
+namespace mrsnake {
+
+Eigen::MatrixX2d mean_value_disk_map(const TriMesh& disk) {
+  using Kernel = CGAL::Simple_cartesian<double>;
+  using Point_2 = Kernel::Point_2;
+  using Point_3 = Kernel::Point_3;
+  using SurfaceMesh = CGAL::Surface_mesh<Point_3>;
+  using VertexIndex = SurfaceMesh::Vertex_index;
+  namespace SMP = CGAL::Surface_mesh_parameterization;
+  using Border = SMP::Circular_border_arc_length_parameterizer_3<SurfaceMesh>;
+  using Matrix = CGAL::Eigen_sparse_matrix<double>::EigenType;
+  using Solver = CGAL::Eigen_solver_traits<Eigen::SparseLU<Matrix, Eigen::COLAMDOrdering<int>>>;
+  using Parameterizer = SMP::Mean_value_coordinates_parameterizer_3<SurfaceMesh, Border, Solver>;
+
+  SurfaceMesh sm;
+  std::vector<VertexIndex> vertex(disk.num_vertices());
+  for (int v = 0; v < disk.num_vertices(); ++v) vertex[v] = sm.add_vertex(Point_3(disk.V(v, 0), disk.V(v, 1), disk.V(v, 2)));
+  for (int f = 0; f < disk.num_faces(); ++f) {
+    const auto face = sm.add_face(vertex[disk.F(f, 0)], vertex[disk.F(f, 1)], vertex[disk.F(f, 2)]);
+    if (face == SurfaceMesh::null_face())
+      throw AlgorithmError("the surface could not be built for parameterization (face " + std::to_string(f) +
+                           " is non-manifold); repair the mesh first");
+  }
+  const auto border = CGAL::Polygon_mesh_processing::longest_border(sm).first;
+  if (border == SurfaceMesh::null_halfedge())
+    throw AlgorithmError("the surface to parameterize has no boundary");
+  auto uv = sm.add_property_map<VertexIndex, Point_2>("v:uv").first;
+  const SMP::Error_code err = SMP::parameterize(sm, Parameterizer(), border, uv);
+  if (err != SMP::OK)
+    throw AlgorithmError(std::string("the parameterization failed (CGAL: ") + SMP::get_error_message(err) +
+                         "); the surface may have degenerate triangles: repair or smooth it first");
+  Eigen::MatrixX2d out(disk.num_vertices(), 2);
+  for (int v = 0; v < disk.num_vertices(); ++v) {
+    const Point_2& p = uv[vertex[v]];
+    out(v, 0) = p.x();
+    out(v, 1) = p.y();
+    if (!std::isfinite(out(v, 0)) || !std::isfinite(out(v, 1)))
+      throw AlgorithmError("the parameterization produced non-finite coordinates; the surface may have degenerate "
+                           "triangles: repair or smooth it first");
+  }
+  return out;
+}
+
+}  // namespace mrsnake

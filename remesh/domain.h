@@ -1,0 +1,56 @@
+#pragma once
+/// \file domain.h
+/// The parameter domain D and a triangulation embedded in it, with point location.
+///
+/// Points of D are 3-vectors so that one orientation test serves both domains: on the unit
+/// sphere a point is a unit vector; in the unit disk the point (x, y) is stored as (x, y, 1).
+/// In both cases det(a, b, c) > 0 means the triangle (a, b, c) is counter-clockwise seen from
+/// outside (sphere) or from +z (disk).
+#include <vector>
+
+#include "mesh/trimesh.h"
+
+namespace mrsnake {
+
+enum class DomainKind { sphere, disk };
+
+/// det(a, b, c): positive for a triangle of D that is not flipped.
+inline double domain_orientation(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  return a.dot(b.cross(c));
+}
+
+/// Brings a point back onto D: onto the sphere, or onto the plane z = 1 (and onto the unit
+/// circle when `on_boundary`).
+Eigen::Vector3d project_to_domain(DomainKind kind, const Eigen::Vector3d& p, bool on_boundary);
+
+/// Number of faces of (D, F) with domain_orientation <= 0.
+int count_flipped(const RowMatrixX3d& D, const RowMatrixX3i& F);
+
+/// Vertices on a boundary edge (an edge used by one face).
+std::vector<bool> boundary_vertices(const RowMatrixX3i& F, int num_vertices);
+
+/// A triangulation embedded in D (the parameterized input), with walking point location.
+class DomainMesh {
+ public:
+  struct Location {
+    int face = -1;
+    Eigen::Vector3d barycentric = Eigen::Vector3d::Zero();  ///< in face's corner order, sum 1, >= 0
+  };
+  /// \pre D has one row per vertex, no face of F is flipped in D.
+  DomainMesh(RowMatrixX3d D, RowMatrixX3i F);
+
+  const RowMatrixX3d& positions() const { return D_; }
+  const RowMatrixX3i& faces() const { return F_; }
+  /// The face holding p (a point of D, any positive scale on the sphere), starting the walk
+  /// at `hint`. Points outside a disk's triangulation (between its boundary chords and the
+  /// circle) get the nearest point of the last face reached.
+  Location locate(const Eigen::Vector3d& p, int hint) const;
+
+ private:
+  Location brute_force(const Eigen::Vector3d& p) const;
+  RowMatrixX3d D_;
+  RowMatrixX3i F_;
+  RowMatrixX3i neighbor_;  ///< neighbor_(f, e): face across the edge opposite corner e, -1 on the boundary
+};
+
+}  // namespace mrsnake

@@ -1,0 +1,164 @@
+#include "remesh/remesh.h"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "mesh/distance.h"
+#include "mesh/errors.h"
+#include "mesh/quality.h"
+#include "remesh/base_mesh.h"
+#include "remesh/domain.h"
+#include "remesh/lift.h"
+#include "remesh/lloyd.h"
+#include "remesh/parameterization.h"
+#include "remesh/shape_smoothing.h"
+
+namespace mrsnake {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+const char* relax_name(RelaxMode mode) {
+  switch (mode) {
+    case RelaxMode::all_vertices: return "all_vertices";
+    case RelaxMode::new_vertices_only: return "new_vertices_only";
+    case RelaxMode::none: return "none";
+  }
+  return "?";
+}
+
+// Levels L and base size n0 so that F0·4^L is near the target, with F0 in [40, 160).
+void choose_resolution(int target_faces, int& levels, int& n0) {
+  levels = 1;
+  double f0 = target_faces / 4.0;
+  while (f0 >= 160) {
+    f0 /= 4;
+    ++levels;
+  }
+  n0 = std::max(8, static_cast<int>(std::lround(f0 / 2 + 2)));
+}
+
+}  // namespace
+
+RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
+  if (options.levels < 0 || options.levels > 12) throw std::invalid_argument("levels must be in [0, 12]");
+  if (options.levels == 0 && options.target_faces < 16) throw std::invalid_argument("target_faces must be at least 16");
+  if (options.lloyd_iterations < 0) throw std::invalid_argument("lloyd_iterations must be >= 0");
+  if (options.shape_iterations < 0) throw std::invalid_argument("shape_iterations must be >= 0");
+  if (options.base_vertices < 6) throw std::invalid_argument("base_vertices must be at least 6");
+  if (!(options.density_exponent >= 0 && options.density_exponent <= 8))
+    throw std::invalid_argument("density_exponent must be in [0, 8]");
+  if (input.empty()) throw InputError("the mesh has no faces");
+
+  RemeshResult result;
+  report(options.progress, "parameterize", 0);
+  const Parameterization param = parameterize(input);
+  result.domain = param.kind == DomainKind::sphere ? "sphere" : "disk";
+  result.parameterization = param.summary;
+
+  int levels = options.levels, n0 = options.base_vertices;
+  if (levels == 0) choose_resolution(options.target_faces, levels, n0);
+
+  const auto base_start = Clock::now();
+  report(options.progress, "base mesh", 0);
+  const BaseMesh base = build_base_mesh(param, n0);
+  n0 = static_cast<int>(base.domain.rows());
+  result.connectivity = subdivide_connectivity(base.faces, n0, levels);
+  result.parameterization["base_vertices"] = n0;
+  result.parameterization["base_faces"] = base.faces.rows();
+  result.parameterization["base_valence_flips"] = base.valence_flips;
+
+  const DomainMesh domain_mesh(param.domain, param.surface.F);
+  DensityField density{&domain_mesh, param.vertex_stretch.array().pow(options.density_exponent).matrix()};
+  const DomainKind kind = param.kind;
+
+  RowMatrixX3d U = base.domain;
+  std::vector<int> hints(n0, 0);
+  for (int i = 0; i < n0; ++i) hints[i] = domain_mesh.locate(U.row(i).transpose(), 0).face;
+
+  LloydOptions lloyd;
+  lloyd.iterations = options.lloyd_iterations;
+  double setup_seconds = seconds_since(base_start);
+
+  for (int j = 0; j <= levels; ++j) {
+    const auto start = Clock::now();
+    const RowMatrixX3i& F = result.connectivity.faces[j];
+    if (j > 0) {
+      U = midpoint_refine(result.connectivity, j - 1, U);
+      const std::vector<bool> boundary =
+          kind == DomainKind::disk ? boundary_vertices(F, static_cast<int>(U.rows())) : std::vector<bool>(U.rows(), false);
+      const int previous = result.connectivity.vertex_count(j - 1);
+      hints.resize(U.rows());
+      for (int v = previous; v < U.rows(); ++v) {
+        U.row(v) = project_to_domain(kind, U.row(v).transpose(), boundary[v]).transpose();
+        hints[v] = hints[result.connectivity.parents(v)[0]];
+      }
+    }
+    LloydStats relax_stats;
+    const bool relax = options.relax == RelaxMode::all_vertices ||
+                       (options.relax == RelaxMode::new_vertices_only && j > 0);
+    if (relax) {
+      lloyd.first_movable = options.relax == RelaxMode::new_vertices_only ? result.connectivity.vertex_count(j - 1) : 0;
+      relax_stats = constrained_lloyd(kind, F, density, U, hints, lloyd);
+    }
+    report(options.progress, "level " + std::to_string(j), 0.5);
+    RemeshLevel level;
+    level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
+    int shape_moves = 0;
+    if (options.relax == RelaxMode::all_vertices && options.shape_iterations > 0) {
+      ShapeSmoothingOptions shape;
+      shape.iterations = options.shape_iterations;
+      shape_moves = smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, shape);
+    }
+    const int flipped = count_flipped(U, F);
+    if (flipped > 0)
+      throw AlgorithmError("level " + std::to_string(j) + " has " + std::to_string(flipped) +
+                           " flipped triangles in the domain; the surface cannot be remeshed well");
+    level.domain_positions = U;
+    level.flipped_triangles = flipped;
+    level.seconds = seconds_since(start) + (j == 0 ? setup_seconds : 0.0);
+    nlohmann::json& s = level.stats;
+    s["level"] = j;
+    s["vertices"] = level.positions.rows();
+    s["faces"] = F.rows();
+    s["flipped_triangles"] = flipped;
+    s["seconds"] = level.seconds;
+    s["lloyd_shortened_moves"] = relax_stats.shortened_moves;
+    s["lloyd_rejected_moves"] = relax_stats.rejected_moves;
+    s["lloyd_last_mean_shift"] = relax_stats.mean_shift;
+    s["shape_moves"] = shape_moves;
+    if (options.compute_stats) {
+      const TriMesh mesh{level.positions, F};
+      s["quality"] = mesh_quality(mesh);
+      s["distance"] = surface_distance(mesh, param.surface);
+    }
+    result.levels.push_back(std::move(level));
+    report(options.progress, "level " + std::to_string(j), 1.0);
+  }
+  return result;
+}
+
+nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& options) {
+  nlohmann::json j;
+  j["domain"] = result.domain;
+  j["levels"] = result.connectivity.levels();
+  j["relax"] = relax_name(options.relax);
+  j["density_exponent"] = options.density_exponent;
+  j["lloyd_iterations"] = options.lloyd_iterations;
+  j["shape_iterations"] = options.relax == RelaxMode::all_vertices ? options.shape_iterations : 0;
+  j["parameterization"] = result.parameterization;
+  double total = result.parameterization.value("seconds", 0.0);
+  nlohmann::json per_level = nlohmann::json::array();
+  for (const auto& level : result.levels) {
+    per_level.push_back(level.stats);
+    total += level.seconds;
+  }
+  j["per_level"] = per_level;
+  j["seconds"] = total;
+  return j;
+}
+
+}  // namespace mrsnake

@@ -1,0 +1,88 @@
+#pragma once
+/// \file remesh.h
+/// Semi-regular remeshing (section 4 of the seed paper): parameterize the input on a convex
+/// domain D, build a base mesh T0 in D, then for each level split 1:4, relax by the constrained
+/// Lloyd iteration and lift to 3D. The result is a nested hierarchy S0..SL whose connectivity is
+/// exactly `subdivide_connectivity(F0, n0, L)`.
+///
+/// Domain: a closed genus-0 input is mapped onto the unit sphere (the boundary of a convex
+/// body; no seam), a disk input onto the unit disk (boundary on the circle).
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "mesh/progress.h"
+#include "mesh/subdivision.h"
+#include "mesh/trimesh.h"
+
+namespace mrsnake {
+
+/// Which vertices the constrained Lloyd iteration moves at each level.
+enum class RelaxMode {
+  all_vertices,       ///< every vertex of the level (default; coarse vertices move too)
+  new_vertices_only,  ///< only the vertices the level adds: the paper's exact method (--strict)
+  none,               ///< no relaxation: plain 1:4 split in D (the paper's baseline, --no-relax)
+};
+
+/// Options of remesh(). Either `levels` or `target_faces` chooses the resolution.
+struct RemeshOptions {
+  /// Number of 1:4 splits L (> 0), or 0 to derive it from target_faces.
+  int levels = 0;
+  /// Wanted face count of the finest level when levels == 0: the base size n0 and L are
+  /// chosen so that F0·4^L is near it.
+  int target_faces = 16000;
+  /// Number of base vertices when `levels` is given (ignored with target_faces).
+  int base_vertices = 32;
+  RelaxMode relax = RelaxMode::all_vertices;
+  /// The Lloyd density is stretch^density_exponent, stretch = A3D/A_D. 2 makes the 3D
+  /// spacing even (2D Lloyd spaces points as density^(-1/4)).
+  double density_exponent = 2.0;
+  /// Lloyd iterations per level (level 0 included unless relax == new_vertices_only).
+  int lloyd_iterations = 8;
+  /// With all_vertices: iterations per level of tangential smoothing toward equilateral 3D
+  /// triangles, moved in D (remesh/shape_smoothing.h). The Lloyd step evens out sizes but is
+  /// affine invariant, so it cannot repair shear; this can. 0 = the Lloyd step alone.
+  int shape_iterations = 3;
+  /// Compute quality and distance per level into RemeshLevel::stats (costs time).
+  bool compute_stats = true;
+  ProgressFn progress;
+};
+
+/// One level of the result.
+struct RemeshLevel {
+  RowMatrixX3d positions;         ///< 3D positions, n_j rows (on the input surface)
+  RowMatrixX3d domain_positions;  ///< positions in D, n_j rows (unit sphere, or z = 1 plane for a disk)
+  int flipped_triangles = 0;      ///< triangles with non-positive orientation in D (always 0)
+  double seconds = 0;             ///< time spent building this level
+  /// Per-level report: vertices, faces, quality (mesh/quality.h keys), distance
+  /// (mesh/distance.h keys, % of the input's diagonal), flipped_triangles, seconds.
+  nlohmann::json stats;
+};
+
+/// What remesh() returns.
+struct RemeshResult {
+  SubdivisionConnectivity connectivity;  ///< faces[j] = subdivide_connectivity(F0, n0, L).faces[j]
+  std::vector<RemeshLevel> levels;       ///< levels[j] for j = 0..L
+  /// "sphere" or "disk".
+  std::string domain;
+  /// Summary of the parameterization: method, distortion range, seconds.
+  nlohmann::json parameterization;
+
+  /// The 3D mesh of level j.
+  TriMesh mesh(int level) const { return {levels[level].positions, connectivity.faces[level]}; }
+};
+
+/// Remeshes a disk or closed genus-0 surface into a nested semi-regular hierarchy.
+/// \pre input has at least one face; options.levels >= 0, options.target_faces > 0.
+/// \throw TopologyError if the input is not a disk or a closed genus-0 surface (the message
+///        names what was found).
+/// \throw AlgorithmError if the parameterization fails or is too distorted, or a level cannot
+///        be built without flipped triangles; nothing partial is returned.
+/// \throw std::invalid_argument on bad options.
+RemeshResult remesh(const TriMesh& input, const RemeshOptions& options);
+
+/// The report.json document of a result: options, parameterization and every level's stats.
+nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& options);
+
+}  // namespace mrsnake

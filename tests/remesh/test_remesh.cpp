@@ -1,0 +1,369 @@
+// Tests of the remesher (section 4 of the seed paper).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "mesh/distance.h"
+#include "mesh/errors.h"
+#include "mesh/mesh_io.h"
+#include "mesh/primitives.h"
+#include "mesh/quality.h"
+#include "mesh/topology.h"
+#include "remesh/domain.h"
+#include "remesh/lloyd.h"
+#include "remesh/parameterization.h"
+#include "remesh/remesh.h"
+#include "tests/test_support.h"
+
+namespace mrsnake {
+namespace {
+
+// An ellipsoid with semi-axes 3, 1.5, 1 (stretches the sphere unevenly).
+TriMesh ellipsoid(int levels) {
+  TriMesh m = icosphere(levels);
+  m.V.col(0) *= 3.0;
+  m.V.col(1) *= 1.5;
+  return m;
+}
+
+// A disk: the part of an icosphere with z < 0.3, slightly flattened.
+TriMesh spherical_cap(int levels) {
+  const TriMesh s = icosphere(levels);
+  std::vector<int> faces;
+  for (int f = 0; f < s.num_faces(); ++f) {
+    const double z = (s.V(s.F(f, 0), 2) + s.V(s.F(f, 1), 2) + s.V(s.F(f, 2), 2)) / 3;
+    if (z < 0.3) faces.push_back(f);
+  }
+  TriMesh cap = extract_faces(s, faces);
+  cap.V.col(0) *= 2.0;
+  return cap;
+}
+
+std::set<std::pair<int, int>> edges_of(const RowMatrixX3i& F) {
+  std::set<std::pair<int, int>> e;
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      e.insert({std::min(a, b), std::max(a, b)});
+    }
+  return e;
+}
+
+RemeshOptions small_options(int levels, int base_vertices, RelaxMode mode = RelaxMode::all_vertices) {
+  RemeshOptions o;
+  o.levels = levels;
+  o.base_vertices = base_vertices;
+  o.relax = mode;
+  o.compute_stats = false;
+  return o;
+}
+
+void expect_nested_and_valid(const RemeshResult& r, const TriMesh& input, bool closed) {
+  const auto& conn = r.connectivity;
+  const int L = conn.levels();
+  ASSERT_EQ(static_cast<int>(r.levels.size()), L + 1);
+  const int n0 = conn.vertex_count(0);
+  // The connectivity is exactly that of subdivide_connectivity of level 0.
+  const SubdivisionConnectivity again = subdivide_connectivity(conn.faces[0], n0, L);
+  const double diag = bounding_box_diagonal(input.V);
+  const SurfaceLocator locator(input);
+  for (int j = 0; j <= L; ++j) {
+    SCOPED_TRACE("level " + std::to_string(j));
+    EXPECT_TRUE(conn.faces[j] == again.faces[j]);
+    EXPECT_EQ(conn.vertex_count(j), again.vertex_count(j));
+    ASSERT_EQ(r.levels[j].positions.rows(), conn.vertex_count(j));
+    ASSERT_EQ(r.levels[j].domain_positions.rows(), conn.vertex_count(j));
+    EXPECT_EQ(r.levels[j].flipped_triangles, 0);
+    EXPECT_EQ(count_flipped(r.levels[j].domain_positions, conn.faces[j]), 0);
+    if (j > 0) {
+      // Exact counts: F_j = 4 F_{j-1}, n_j = n_{j-1} + E_{j-1}.
+      EXPECT_EQ(conn.faces[j].rows(), 4 * conn.faces[j - 1].rows());
+      const auto previous_edges = edges_of(conn.faces[j - 1]);
+      EXPECT_EQ(conn.vertex_count(j), conn.vertex_count(j - 1) + static_cast<int>(previous_edges.size()));
+      if (closed) EXPECT_EQ(2 * static_cast<int>(previous_edges.size()), 3 * static_cast<int>(conn.faces[j - 1].rows()));
+      // Every new vertex records an edge of the previous level as its parent.
+      for (int v = conn.vertex_count(j - 1); v < conn.vertex_count(j); ++v) {
+        const Eigen::Vector2i p = conn.parents(v);
+        EXPECT_TRUE(previous_edges.count({std::min(p[0], p[1]), std::max(p[0], p[1])})) << "vertex " << v;
+        EXPECT_EQ(conn.level_of_vertex(v), j);
+      }
+    }
+    // Lifted vertices lie on the input surface.
+    EXPECT_LT(locator.distances(r.levels[j].positions).maxCoeff(), 1e-9 * diag);
+    const TopologyReport topo = topology_report(r.mesh(j));
+    EXPECT_TRUE(closed ? topo.is_closed_genus0() : topo.is_disk()) << topo.describe();
+  }
+}
+
+TEST(Remesh, EllipsoidNestsExactlyWithoutFlipsInEveryMode) {
+  const TriMesh input = ellipsoid(4);
+  for (RelaxMode mode : {RelaxMode::all_vertices, RelaxMode::new_vertices_only, RelaxMode::none}) {
+    SCOPED_TRACE(static_cast<int>(mode));
+    const RemeshResult r = remesh(input, small_options(3, 20, mode));
+    EXPECT_EQ(r.domain, "sphere");
+    EXPECT_EQ(r.connectivity.vertex_count(0), 20);
+    EXPECT_EQ(r.connectivity.faces[0].rows(), 36);  // closed: F0 = 2 n0 - 4
+    EXPECT_EQ(r.connectivity.faces[3].rows(), 36 * 64);
+    EXPECT_EQ(r.connectivity.vertex_count(3), 2 + 36 * 64 / 2);
+    expect_nested_and_valid(r, input, true);
+  }
+}
+
+TEST(Remesh, StrictModeKeepsCoarseVerticesInTheDomain) {
+  const RemeshResult r = remesh(ellipsoid(3), small_options(2, 16, RelaxMode::new_vertices_only));
+  for (int j = 1; j <= 2; ++j) {
+    const int n = r.connectivity.vertex_count(j - 1);
+    EXPECT_TRUE(r.levels[j].domain_positions.topRows(n).isApprox(r.levels[j - 1].domain_positions, 1e-15));
+  }
+}
+
+TEST(Remesh, DiskInputStaysADiskWithBoundaryOnTheCircle) {
+  const TriMesh input = spherical_cap(4);
+  ASSERT_TRUE(topology_report(input).is_disk());
+  const RemeshResult r = remesh(input, small_options(3, 24));
+  EXPECT_EQ(r.domain, "disk");
+  expect_nested_and_valid(r, input, false);
+  const RowMatrixX3d& D = r.levels.back().domain_positions;
+  const auto boundary = boundary_vertices(r.connectivity.faces.back(), static_cast<int>(D.rows()));
+  for (int v = 0; v < D.rows(); ++v) {
+    EXPECT_DOUBLE_EQ(D(v, 2), 1.0);
+    if (boundary[v]) EXPECT_NEAR(std::hypot(D(v, 0), D(v, 1)), 1.0, 1e-12);
+    else EXPECT_LT(std::hypot(D(v, 0), D(v, 1)), 1.0);
+  }
+}
+
+TEST(Remesh, TargetFacesChoosesBaseAndLevels) {
+  RemeshOptions o;
+  o.target_faces = 4000;
+  o.compute_stats = false;
+  const RemeshResult r = remesh(ellipsoid(4), o);
+  const double finest = static_cast<double>(r.connectivity.faces.back().rows());
+  EXPECT_GT(finest, 4000 / 1.3);
+  EXPECT_LT(finest, 4000 * 1.3);
+  EXPECT_GE(r.connectivity.vertex_count(0), 20);
+  EXPECT_LE(r.connectivity.vertex_count(0), 80);
+}
+
+TEST(Remesh, RelaxedBeatsUnrelaxedOnAnEllipsoid) {
+  const TriMesh input = ellipsoid(4);
+  RemeshOptions relaxed = small_options(3, 24);
+  relaxed.compute_stats = true;
+  RemeshOptions plain = relaxed;
+  plain.relax = RelaxMode::none;
+  const auto a = remesh(input, relaxed).levels.back().stats;
+  const auto b = remesh(input, plain).levels.back().stats;
+  const auto& qa = a["quality"];
+  const auto& qb = b["quality"];
+  EXPECT_GT(qa["min_angle_deg"].get<double>(), qb["min_angle_deg"].get<double>());
+  EXPECT_GT(qa["q_min"].get<double>(), qb["q_min"].get<double>());
+  EXPECT_GT(qa["q_mean"].get<double>(), qb["q_mean"].get<double>());
+  EXPECT_LT(qa["edge_length_cv"].get<double>(), qb["edge_length_cv"].get<double>());
+  EXPECT_LT(qa["area_cv"].get<double>(), qb["area_cv"].get<double>());
+  EXPECT_LE(a["distance"]["hausdorff_pct"].get<double>(), b["distance"]["hausdorff_pct"].get<double>());
+}
+
+TEST(Remesh, RefusesOtherTopologiesNamingWhatWasFound) {
+  TriMesh two = icosphere(1);
+  TriMesh shifted = icosphere(1);
+  shifted.V.col(0).array() += 5.0;
+  TriMesh both;
+  both.V.resize(two.V.rows() * 2, 3);
+  both.V << two.V, shifted.V;
+  both.F.resize(two.F.rows() * 2, 3);
+  both.F << two.F, (shifted.F.array() + static_cast<int>(two.V.rows())).matrix();
+  try {
+    remesh(both, small_options(1, 8));
+    FAIL() << "two components were accepted";
+  } catch (const TopologyError& e) {
+    EXPECT_NE(std::string(e.what()).find("component"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Remesh, ParameterizationOfTheSphereIsBalancedAndUnflipped) {
+  const TriMesh input = ellipsoid(3);
+  const Parameterization p = parameterize(input);
+  EXPECT_EQ(p.kind, DomainKind::sphere);
+  EXPECT_EQ(count_flipped(p.domain, p.surface.F), 0);
+  for (int v = 0; v < p.domain.rows(); ++v) EXPECT_NEAR(p.domain.row(v).norm(), 1.0, 1e-12);
+  EXPECT_TRUE((p.face_stretch.array() > 0).all());
+}
+
+TEST(Remesh, MobiusMapKeepsTheSphereAndCentresThePoint) {
+  const Eigen::Vector3d a(0.3, -0.2, 0.5);
+  const TriMesh s = icosphere(2);
+  for (int v = 0; v < s.num_vertices(); ++v)
+    EXPECT_NEAR(mobius_to_center(a, s.V.row(v).transpose()).norm(), 1.0, 1e-12);
+  // Orientation is preserved.
+  for (int f = 0; f < s.num_faces(); ++f) {
+    const Eigen::Vector3d p = mobius_to_center(a, s.V.row(s.F(f, 0))), q = mobius_to_center(a, s.V.row(s.F(f, 1))),
+                          r = mobius_to_center(a, s.V.row(s.F(f, 2)));
+    EXPECT_GT(domain_orientation(p, q, r), 0);
+  }
+}
+
+// The paper's Fig. 1: a vertex with a non-convex 1-ring. Its Voronoi cell pokes out of the
+// ring (an obtuse triangle's circumcenter lies outside), while N(v) stays inside, and the
+// constrained Lloyd iteration flips nothing.
+TEST(Lloyd, CellStaysInsideANonConvexOneRing) {
+  RowMatrixX3d U(7, 3);
+  U << 0, 0, 1,          // v
+      1.0, 0.0, 1,        //
+      0.5, 0.05, 1,       // reflex ring vertex, close to v: non-convex ring
+      0.0, 1.0, 1,        //
+      -1.0, 0.2, 1,       //
+      -0.6, -1.0, 1,      //
+      0.6, -1.0, 1;
+  RowMatrixX3i F(6, 3);
+  F << 0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 5, 0, 5, 6, 0, 6, 1;
+  ASSERT_EQ(count_flipped(U, F), 0);
+  auto inside_ring = [&](const Eigen::Vector3d& p) {
+    // Inside the 1-ring = inside one of its triangles (closed).
+    for (int f = 0; f < F.rows(); ++f) {
+      const Eigen::Vector3d a = U.row(F(f, 0)), b = U.row(F(f, 1)), c = U.row(F(f, 2));
+      if (domain_orientation(p, b, c) >= -1e-12 && domain_orientation(a, p, c) >= -1e-12 &&
+          domain_orientation(a, b, p) >= -1e-12)
+        return true;
+    }
+    return false;
+  };
+  // The ring is non-convex at vertex 2 ...
+  EXPECT_LT(domain_orientation(U.row(1), U.row(2), U.row(3)), 0);
+  // ... and the circumcenter of the obtuse triangle (v, 1, 2) lies outside the ring.
+  const Eigen::Vector2d a(0, 0), b(1, 0), c(0.5, 0.05);
+  const double d = 2 * (a.x() * (b.y() - c.y()) + b.x() * (c.y() - a.y()) + c.x() * (a.y() - b.y()));
+  const Eigen::Vector3d circumcenter(
+      (a.squaredNorm() * (b.y() - c.y()) + b.squaredNorm() * (c.y() - a.y()) + c.squaredNorm() * (a.y() - b.y())) / d,
+      (a.squaredNorm() * (c.x() - b.x()) + b.squaredNorm() * (a.x() - c.x()) + c.squaredNorm() * (b.x() - a.x())) / d, 1);
+  EXPECT_FALSE(inside_ring(circumcenter));
+  const auto cell = lloyd_cell(F, U, 0);
+  ASSERT_EQ(cell.size(), 6u);
+  double cell_area = 0, ring_area = 0;
+  for (const auto& quad : cell) {
+    for (const auto& p : quad) EXPECT_TRUE(inside_ring(p)) << p.transpose();
+    cell_area += 0.5 * ((quad[1] - quad[0]).cross(quad[2] - quad[0]).norm() + (quad[2] - quad[0]).cross(quad[3] - quad[0]).norm());
+  }
+  for (int f = 0; f < F.rows(); ++f)
+    ring_area += 0.5 * (U.row(F(f, 1)) - U.row(F(f, 0))).cross(U.row(F(f, 2)) - U.row(F(f, 0))).norm();
+  EXPECT_NEAR(cell_area, ring_area / 3, 1e-12);  // N(v) is a third of each 1-ring triangle
+  EXPECT_TRUE(inside_ring(lloyd_cell_centroid(F, U, 0)));
+
+  // Relax v under a constant density on a domain mesh covering the ring.
+  std::vector<int> hints(7, 0);
+  LloydOptions options;
+  options.iterations = 50;
+  // Only v moves (the ring vertices are "coarse"): make v the last vertex.
+  RowMatrixX3d W(7, 3);
+  W << U.bottomRows(6), U.row(0);
+  RowMatrixX3i G = F;
+  for (int f = 0; f < G.rows(); ++f)
+    for (int k = 0; k < 3; ++k) G(f, k) = G(f, k) == 0 ? 6 : G(f, k) - 1;
+  options.first_movable = 6;
+  const DomainMesh wdomain(W, G);
+  DensityField wdensity{&wdomain, Eigen::VectorXd::Ones(7)};
+  const LloydStats stats = constrained_lloyd(DomainKind::disk, G, wdensity, W, hints, options);
+  EXPECT_EQ(count_flipped(W, G), 0);
+  EXPECT_GT(stats.moves, 0);
+  // Converged to its own cell's centroid.
+  EXPECT_LT((lloyd_cell_centroid(G, W, 6) - Eigen::Vector3d(W.row(6))).norm(), 1e-6);
+}
+
+// Real meshes: zero flipped triangles at every level (kept small for a fast suite).
+void expect_no_flips_on(const std::string& path) {
+  const TriMesh input = read_mesh(path);
+  for (RelaxMode mode : {RelaxMode::all_vertices, RelaxMode::new_vertices_only, RelaxMode::none}) {
+    RemeshOptions o;
+    o.target_faces = 4000;
+    o.relax = mode;
+    o.compute_stats = false;
+    const RemeshResult r = remesh(input, o);
+    for (int j = 0; j <= r.connectivity.levels(); ++j) {
+      EXPECT_EQ(count_flipped(r.levels[j].domain_positions, r.connectivity.faces[j]), 0) << path << " level " << j;
+      EXPECT_EQ(r.levels[j].flipped_triangles, 0);
+    }
+  }
+}
+
+TEST(RemeshData, BlobbyHasNoFlippedTriangles) {
+  MRSNAKE_REQUIRE_DATA(path, "meshes/blobby.off");
+  expect_no_flips_on(path);
+}
+
+TEST(RemeshData, MushroomHasNoFlippedTriangles) {
+  MRSNAKE_REQUIRE_DATA(path, "meshes/mushroom.off");
+  expect_no_flips_on(path);
+}
+
+TEST(RemeshData, RetinalHasNoFlippedTriangles) {
+  MRSNAKE_REQUIRE_DATA(path, "meshes/retinal.off");
+  expect_no_flips_on(path);
+}
+
+// The command line.
+TEST(RemeshCli, WritesNestedLevelsAndReport) {
+  const auto dir = test::scratch_dir("remesh-cli");
+  const std::string input = (dir / "ellipsoid.off").string();
+  write_mesh(input, ellipsoid(3));
+  const auto out = dir / "model";
+  const auto r = test::run_mrsnake("-q remesh " + input + " -o " + out.string() + " --levels 2 --base-vertices 12");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const TriMesh l0 = read_mesh((out / "level_0.vtp").string());
+  const SubdivisionConnectivity conn = subdivide_connectivity(l0.F, l0.num_vertices(), 2);
+  for (int j = 0; j <= 2; ++j) {
+    const TriMesh lj = read_mesh((out / ("level_" + std::to_string(j) + ".vtp")).string());
+    EXPECT_EQ(lj.num_vertices(), conn.vertex_count(j));
+    EXPECT_TRUE(lj.F == conn.faces[j]) << "level " << j;
+  }
+  std::ifstream in(out / "report.json");
+  const auto report = nlohmann::json::parse(in);
+  ASSERT_EQ(report["per_level"].size(), 3u);
+  for (const auto& level : report["per_level"]) {
+    for (const char* key : {"vertices", "faces", "flipped_triangles", "seconds", "quality", "distance"})
+      EXPECT_TRUE(level.contains(key)) << key;
+    EXPECT_TRUE(level["quality"].contains("q_min"));
+    EXPECT_TRUE(level["quality"].contains("pct_valence6_interior"));
+    EXPECT_TRUE(level["distance"].contains("rms_pct"));
+    EXPECT_TRUE(level["distance"].contains("hausdorff_pct"));
+    EXPECT_EQ(level["flipped_triangles"].get<int>(), 0);
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(RemeshCli, RefusesGenus3AndFiveBoundaryLoopsWritingNothing) {
+  const auto dir = test::scratch_dir("remesh-refuse");
+  {
+    MRSNAKE_REQUIRE_DATA(elephant, "meshes/elephant.off");
+    const auto r = test::run_mrsnake("remesh " + elephant + " -o " + (dir / "e").string());
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    EXPECT_NE(r.output.find("genus 3"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir / "e"));
+  }
+  {
+    MRSNAKE_REQUIRE_DATA(lion, "meshes/lion.off");
+    const auto r = test::run_mrsnake("remesh " + lion + " -o " + (dir / "l").string());
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    EXPECT_NE(r.output.find("5 boundary loops"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir / "l"));
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(RemeshCli, DegenerateInputFailsWithoutWriting) {
+  const auto dir = test::scratch_dir("remesh-degenerate");
+  TriMesh flat = icosphere(2);
+  flat.V.setZero();  // every triangle has zero area: no parameterization exists
+  const std::string input = (dir / "flat.off").string();
+  write_mesh(input, flat);
+  const auto r = test::run_mrsnake("remesh " + input + " -o " + (dir / "out").string() + " --levels 1");
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.exit_code, 1) << "an internal error instead of a clear message: " << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "level_0.vtp"));
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace mrsnake
