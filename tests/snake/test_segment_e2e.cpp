@@ -197,3 +197,28 @@ TEST(SegmentCommand, WritesEveryOutputOnTheImageGridWithScores) {
   EXPECT_FALSE(std::filesystem::exists(dir / "seg2"));
   std::filesystem::remove_all(dir);
 }
+
+TEST(SegmentCommand, SynthBuildModelWithImageThenSegment) {
+  // The whole command-line path: two synthetic instances, a model with its appearance from
+  // the reference (remeshed by build-model), then segment with --truth.
+  const auto dir = mrsnake::test::scratch_dir("segment-roundtrip");
+  const std::string d = dir.string();
+  for (const auto& [name, seed] : {std::pair<std::string, int>{"ref", 22}, {"tgt", 21}}) {
+    const auto r = mrsnake::test::run_mrsnake("-q synth --shape blob --size 56 --snr 4 --pose random --deform 2 --seed " +
+                                              std::to_string(seed) + " -o " + d + "/" + name);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  const auto b = mrsnake::test::run_mrsnake("-q build-model --labels " + d + "/ref/truth.nii.gz --label 1 --image " + d +
+                                            "/ref/image.nii.gz -o " + d + "/blob.model --faces 8000");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const auto s = mrsnake::test::run_mrsnake("segment --image " + d + "/tgt/image.nii.gz --model " + d +
+                                            "/blob.model -o " + d + "/seg --truth " + d + "/tgt/truth.nii.gz --json -q");
+  ASSERT_EQ(s.exit_code, 0) << s.output;
+  const nlohmann::json rep = nlohmann::json::parse(s.output);
+  EXPECT_EQ(rep["force"], "profile");  // the model has an appearance
+  EXPECT_EQ(rep["self_intersections"], 0);
+  EXPECT_GE(rep["scores"]["dice"].get<double>(), 0.95);
+  std::printf("build-model --image + segment: Dice %.4f ASSD %.3f mm\n", rep["scores"]["dice"].get<double>(),
+              rep["scores"]["assd_mm"].get<double>());
+  std::filesystem::remove_all(dir);
+}
