@@ -14,7 +14,11 @@
 #include <itkNiftiImageIOFactory.h>
 #include <itkNrrdImageIOFactory.h>
 
+#include <zlib.h>
+
 #include <cmath>
+#include <fstream>
+#include <vector>
 #include <filesystem>
 #include <mutex>
 
@@ -56,6 +60,44 @@ Volume to_volume(const FloatImage* image, const std::string& path) {
   return v;
 }
 
+// ITK's readers fill a truncated gzip stream with zeros instead of failing, which would
+// turn a damaged scan into a silently wrong segmentation. zlib reports a stream that ends
+// early or fails its CRC.
+void check_gzip_complete(const std::string& path) {
+  std::ifstream probe(path, std::ios::binary);
+  unsigned char magic[2] = {0, 0};
+  probe.read(reinterpret_cast<char*>(magic), 2);
+  if (magic[0] != 0x1f || magic[1] != 0x8b) return;
+  gzFile f = gzopen(path.c_str(), "rb");
+  if (!f) throw InputError("cannot open '" + path + "'");
+  std::vector<char> buffer(1 << 20);
+  int n = 0;
+  while ((n = gzread(f, buffer.data(), static_cast<unsigned>(buffer.size()))) > 0) {
+  }
+  int err = Z_OK;
+  const char* message = gzerror(f, &err);
+  const bool complete = n == 0 && err == Z_OK && gzeof(f);
+  const std::string why = message ? message : "";
+  gzclose(f);
+  if (!complete)
+    throw InputError("'" + path + "' is truncated or corrupt (" + (why.empty() ? "incomplete gzip stream" : why) +
+                     "); re-export or re-copy the file");
+}
+
+bool file_extension_is_plain(const std::string& path) {
+  return path.size() < 3 || path.compare(path.size() - 3, 3, ".gz") != 0;
+}
+
+// An uncompressed image must hold all of its voxels (ITK zero-fills a short file too).
+void check_size(const std::string& path, const itk::ImageIOBase* io) {
+  std::error_code ec;
+  const auto bytes = std::filesystem::file_size(path, ec);
+  if (ec || io->GetFileName() != path) return;  // data in a separate file (e.g. .mhd + .raw)
+  if (bytes < static_cast<std::uintmax_t>(io->GetImageSizeInBytes()))
+    throw InputError("'" + path + "' is truncated: it holds " + std::to_string(bytes) + " bytes for " +
+                     std::to_string(io->GetImageSizeInBytes()) + " bytes of voxels");
+}
+
 Volume read_dicom_series(const std::string& dir) {
   auto names = itk::GDCMSeriesFileNames::New();
   names->SetUseSeriesDetails(true);
@@ -77,6 +119,7 @@ Volume read_volume(const std::string& path) {
   if (!std::filesystem::exists(path, ec)) throw InputError("image '" + path + "' does not exist; check the path");
   try {
     if (std::filesystem::is_directory(path, ec)) return read_dicom_series(path);
+    check_gzip_complete(path);
     auto io = itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::ImageIOFactory::IOFileModeEnum::ReadMode);
     if (!io) throw InputError("'" + path + "' is not an image format mrsnake reads (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)");
     io->SetFileName(path);
@@ -92,6 +135,7 @@ Volume read_volume(const std::string& path) {
     if (io->GetNumberOfComponents() != 1)
       throw InputError("'" + path + "' has " + std::to_string(io->GetNumberOfComponents()) +
                        " components per voxel; mrsnake needs a scalar image");
+    if (file_extension_is_plain(path)) check_size(path, io);
     auto reader = itk::ImageFileReader<FloatImage>::New();
     reader->SetFileName(path);
     reader->SetImageIO(io);

@@ -1,0 +1,195 @@
+// Bad inputs, end to end through the mrsnake command: each test is one row of
+// docs/robustness.md. Every case must give a one-line error with a non-zero exit code (or
+// a documented, sane result), never a crash, and never an output under its final name.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+
+#include <nlohmann/json.hpp>
+
+#include "mesh/image_io.h"
+#include "tests/test_support.h"
+
+using mrsnake::test::run_mrsnake;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// One line of output that names the problem (no stack traces, no VTK/ITK dumps).
+void expect_one_line_error(const mrsnake::test::CommandResult& r, int code, const std::string& needle) {
+  EXPECT_EQ(r.exit_code, code) << r.output;
+  EXPECT_NE(r.output.find("mrsnake: error: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(needle), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("itk::"), std::string::npos) << r.output;
+}
+
+/// A NIfTI-1 file with the given dimensions (uint8 voxels), written by hand so that 2D and
+/// 4D images can be made.
+void write_nifti(const fs::path& path, const std::vector<short>& dims) {
+  char header[352] = {};
+  const int sizeof_hdr = 348;
+  std::memcpy(header, &sizeof_hdr, 4);
+  short dim[8] = {static_cast<short>(dims.size()), 1, 1, 1, 1, 1, 1, 1};
+  std::size_t voxels = 1;
+  for (std::size_t i = 0; i < dims.size(); ++i) {
+    dim[i + 1] = dims[i];
+    voxels *= static_cast<std::size_t>(dims[i]);
+  }
+  std::memcpy(header + 40, dim, sizeof dim);
+  const short datatype = 2, bitpix = 8;  // unsigned char
+  std::memcpy(header + 70, &datatype, 2);
+  std::memcpy(header + 72, &bitpix, 2);
+  float pixdim[8] = {1, 1, 1, 1, 1, 1, 1, 1};
+  std::memcpy(header + 76, pixdim, sizeof pixdim);
+  const float vox_offset = 352;
+  std::memcpy(header + 108, &vox_offset, 4);
+  std::memcpy(header + 344, "n+1\0", 4);
+  std::ofstream f(path, std::ios::binary);
+  f.write(header, sizeof header);
+  const std::vector<char> data(voxels, 1);
+  f.write(data.data(), static_cast<std::streamsize>(data.size()));
+}
+
+int count_entries(const fs::path& dir) {
+  int n = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++n;
+  return n;
+}
+
+}  // namespace
+
+/// One small synthetic case and a model built from another instance, shared by the tests.
+class Robustness : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(mrsnake::test::scratch_dir("robustness"));
+    const std::string d = dir_->string();
+    for (const auto& [name, seed] : {std::pair<std::string, int>{"ref", 5}, {"tgt", 6}}) {
+      const auto r = run_mrsnake("-q synth --shape ellipsoid --size 48 --snr 6 --pose random --seed " +
+                                 std::to_string(seed) + " -o " + d + "/" + name);
+      ASSERT_EQ(r.exit_code, 0) << r.output;
+    }
+    const auto b = run_mrsnake("-q build-model --labels " + d + "/ref/truth.nii.gz --label 1 -o " + d +
+                               "/ellipsoid.model --faces 4000");
+    ASSERT_EQ(b.exit_code, 0) << b.output;
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*dir_);
+    delete dir_;
+  }
+  static std::string path(const std::string& name) { return (*dir_ / name).string(); }
+  static fs::path* dir_;
+};
+fs::path* Robustness::dir_ = nullptr;
+
+TEST_F(Robustness, CorruptImage) {
+  std::ofstream(path("corrupt.nii.gz"), std::ios::binary) << "this is not a NIfTI file at all";
+  expect_one_line_error(run_mrsnake("mc --labels " + path("corrupt.nii.gz") + " --label 1 -o " + path("c.vtp")), 3,
+                        "corrupt.nii.gz");
+  EXPECT_FALSE(fs::exists(path("c.vtp")));
+}
+
+TEST_F(Robustness, TruncatedImage) {
+  std::ifstream in(path("tgt/image.nii.gz"), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::ofstream(path("truncated.nii.gz"), std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  expect_one_line_error(run_mrsnake("segment --image " + path("truncated.nii.gz") + " --model " +
+                                    path("ellipsoid.model") + " -o " + path("seg-trunc")),
+                        3, "truncated.nii.gz");
+  EXPECT_FALSE(fs::exists(path("seg-trunc")));
+}
+
+TEST_F(Robustness, TwoDimensionalAndFourDimensionalImages) {
+  write_nifti(path("flat.nii"), {32, 32});
+  expect_one_line_error(run_mrsnake("mc --labels " + path("flat.nii") + " --label 1 -o " + path("f.vtp")), 3, "2D image");
+  write_nifti(path("series.nii"), {16, 16, 16, 3});
+  expect_one_line_error(run_mrsnake("mc --labels " + path("series.nii") + " --label 1 -o " + path("s.vtp")), 3,
+                        "4D image");
+  // A 3D image stored with a trailing singleton dimension is a 3D image.
+  write_nifti(path("single.nii"), {16, 16, 16, 1});
+  EXPECT_EQ(run_mrsnake("mc --labels " + path("single.nii") + " --label 1 -o " + path("one.vtp")).exit_code, 0);
+}
+
+TEST_F(Robustness, EmptyLabelVolume) {
+  mrsnake::Volume empty;
+  empty.size = {20, 20, 20};
+  empty.data.assign(empty.num_voxels(), 0.f);
+  mrsnake::write_volume(path("empty.nii.gz"), empty, mrsnake::VoxelType::uint8);
+  expect_one_line_error(run_mrsnake("build-model --labels " + path("empty.nii.gz") + " --label 1 -o " + path("e.model")),
+                        3, "not present");
+  EXPECT_FALSE(fs::exists(path("e.model")));
+}
+
+TEST_F(Robustness, NanAndInfVoxelsAreIgnored) {
+  mrsnake::Volume image = mrsnake::read_volume(path("tgt/image.nii.gz"));
+  for (std::size_t i = 0; i < image.data.size(); i += 97) image.data[i] = std::numeric_limits<float>::quiet_NaN();
+  for (std::size_t i = 13; i < image.data.size(); i += 101) image.data[i] = std::numeric_limits<float>::infinity();
+  mrsnake::write_volume(path("nan.nii.gz"), image, mrsnake::VoxelType::float32);
+  const auto r = run_mrsnake("-q segment --image " + path("nan.nii.gz") + " --model " + path("ellipsoid.model") + " -o " +
+                             path("seg-nan") + " --truth " + path("tgt/truth.nii.gz") + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto report = nlohmann::json::parse(r.output);
+  EXPECT_GE(report["scores"]["dice"].get<double>(), 0.9) << "1% of the voxels are NaN or Inf";
+  EXPECT_EQ(report["self_intersections"], 0);
+}
+
+TEST_F(Robustness, ExtremeAnisotropy) {
+  const auto s = run_mrsnake("-q synth --shape ellipsoid --size 96,96,12 --spacing 0.4,0.4,5 --snr 6 --seed 9 -o " +
+                             path("aniso"));
+  ASSERT_EQ(s.exit_code, 0) << s.output;
+  const auto r = run_mrsnake("-q segment --image " + path("aniso/image.nii.gz") + " --model " + path("ellipsoid.model") +
+                             " -o " + path("seg-aniso") + " --truth " + path("aniso/truth.nii.gz") + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto report = nlohmann::json::parse(r.output);
+  EXPECT_EQ(report["self_intersections"], 0);
+  EXPECT_GE(report["scores"]["dice"].get<double>(), 0.8) << "5 mm slices, 0.4 mm in plane";
+  const mrsnake::Volume labels = mrsnake::read_volume(path("seg-aniso/labels.nii.gz"));
+  EXPECT_EQ(labels.size, (std::array<std::size_t, 3>{96, 96, 12}));
+  EXPECT_DOUBLE_EQ(labels.spacing[2], 5.0);
+}
+
+TEST_F(Robustness, UnwritableOutput) {
+  std::ofstream(path("a-file")) << "x";
+  expect_one_line_error(run_mrsnake("segment --image " + path("tgt/image.nii.gz") + " --model " +
+                                    path("ellipsoid.model") + " -o " + path("a-file/seg")),
+                        4, "a-file");
+}
+
+TEST_F(Robustness, InterruptLeavesNoPartialOutput) {
+  const fs::path out = *dir_ / "interrupted";
+  fs::create_directories(out);
+  const char* bin = std::getenv("MRSNAKE_BIN");
+  ASSERT_NE(bin, nullptr);
+  for (int sig : {SIGINT, SIGTERM}) {
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      const std::string model = (out / "big.model").string();
+      execl(bin, bin, "-q", "build-model", "--labels", path("ref/truth.nii.gz").c_str(), "--label", "1", "-o",
+            model.c_str(), "--faces", "130000", static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    usleep(700000);  // build-model at 130k faces takes several seconds: interrupt it mid-way
+    kill(child, sig);
+    int status = 0;
+    waitpid(child, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by a signal instead of exiting cleanly";
+    EXPECT_EQ(WEXITSTATUS(status), 128 + sig) << "it finished before the interrupt; make the job bigger";
+    EXPECT_EQ(count_entries(out), 0) << "a partial output or temporary survived";
+  }
+}
+
+TEST_F(Robustness, TruncatedUncompressedImage) {
+  write_nifti(path("full.nii"), {16, 16, 16});
+  std::ifstream in(path("full.nii"), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::ofstream(path("short.nii"), std::ios::binary) << bytes.substr(0, 352 + 1000);
+  expect_one_line_error(run_mrsnake("mc --labels " + path("short.nii") + " --label 1 -o " + path("t.vtp")), 3,
+                        "truncated");
+}
