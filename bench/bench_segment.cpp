@@ -5,7 +5,7 @@
 // load seconds, peak memory and the speed-up of the snake over the best ITK level set.
 //
 // Usage: bench_segment [--quick] [--real DATA_DIR] [--mrsnake BIN] [--work DIR] [--json OUT] [--keep]
-//                      [--only CASE_SUBSTRING] [--gac PROPAGATION,CURVATURE,ADVECTION[,BETA_FRACTION,ALPHA_DIVISOR]]
+//                      [--only CASE_SUBSTRING] [--gac PROPAGATION,CURVATURE,ADVECTION[,SIGMA_MM,BETA_FRACTION,ALPHA_DIVISOR]]
 //   --keep also writes each level set's labels into the work folder.
 //   default: synthetic cases at 128³ and 256³; --quick: 128³ only;
 //   --real DATA_DIR: the liver of abdomen-ct-small and the genus-0 brain structures of MRIcrop.
@@ -388,17 +388,29 @@ struct Bench {
 };
 
 void synthetic_cases(Bench& b, bool quick) {
+  struct Variant {
+    double snr;
+    bool posed;
+  };
   struct Size {
     int voxels, levels;
-    std::vector<double> snrs;
+    std::vector<Variant> variants;
   };
-  std::vector<Size> sizes{{128, 4, {8, 4, 2}}};
-  if (!quick) sizes.push_back({256, 5, {8, 4}});
-  int seed = 1;
+  // Modest counts: a full run fits in ~20 minutes on two cores (ITK's level sets dominate).
+  std::vector<Size> sizes{{128, 4, {{8, false}, {8, true}, {4, false}, {4, true}, {2, true}}}};
+  if (!quick) sizes.push_back({256, 5, {{8, false}, {4, true}}});
   for (const Size& size : sizes)
     for (const std::string shape : {"blob", "heart"}) {
       const std::string deform = std::to_string(size.voxels / 32);  // mm: 4 at 128³, 8 at 256³
       const std::string tag = shape + "-" + std::to_string(size.voxels);
+      const auto case_name = [&](double snr, bool posed) {
+        char name[96];
+        std::snprintf(name, sizeof name, "%s %d³ SNR %g %s", shape.c_str(), size.voxels, snr, posed ? "posed" : "centred");
+        return std::string(name);
+      };
+      bool wanted = b.only.empty();
+      for (const Variant& v : size.variants) wanted = wanted || case_name(v.snr, v.posed).find(b.only) != std::string::npos;
+      if (!wanted) continue;
       const fs::path mdir = b.work / ("model-" + tag);
       fs::create_directories(mdir);
       // The model: another instance of the shape (its own seed, no pose, its own deformation).
@@ -408,16 +420,18 @@ void synthetic_cases(Bench& b, bool quick) {
       const fs::path model = mdir / "model";
       const int levels = b.build_model(mdir / "case" / "truth.nii.gz", 1, mdir / "case" / "image.nii.gz", model,
                                        {"--levels", std::to_string(size.levels)});
-      for (double snr : size.snrs)
-        for (const bool posed : {false, true}) {
+      for (std::size_t vi = 0; vi < size.variants.size(); ++vi) {
+          const double snr = size.variants[vi].snr;
+          const bool posed = size.variants[vi].posed;
+          // The same case whatever --only selects.
+          const int case_seed = size.voxels * 100 + (shape == "blob" ? 0 : 50) + static_cast<int>(vi);
           Case c;
-          char name[96];
-          std::snprintf(name, sizeof name, "%s %d³ SNR %g %s", shape.c_str(), size.voxels, snr, posed ? "posed" : "centred");
-          c.name = name;
+          c.name = case_name(snr, posed);
+          if (!b.only.empty() && c.name.find(b.only) == std::string::npos) continue;
           c.dir = b.work / (tag + "-snr" + std::to_string(static_cast<int>(snr)) + (posed ? "-posed" : "-centred"));
           fs::create_directories(c.dir);
           std::vector<std::string> args{"synth", "--shape", shape, "--size", std::to_string(size.voxels), "--snr",
-                                        std::to_string(snr), "--deform", deform, "--seed", std::to_string(seed++),
+                                        std::to_string(snr), "--deform", deform, "--seed", std::to_string(case_seed),
                                         "-o", (c.dir / "case").string()};
           if (posed) {
             args.push_back("--pose");
@@ -499,7 +513,7 @@ int main(int argc, char** argv) {
     else {
       std::fprintf(stderr,
                    "usage: bench_segment [--quick] [--real DATA_DIR] [--mrsnake BIN] [--work DIR] [--json OUT] [--keep]\n"
-                   "                     [--only CASE_SUBSTRING] [--gac PROPAGATION,CURVATURE,ADVECTION[,BETA_FRACTION,ALPHA_DIVISOR]]\n");
+                   "                     [--only CASE_SUBSTRING] [--gac PROPAGATION,CURVATURE,ADVECTION[,SIGMA_MM,BETA_FRACTION,ALPHA_DIVISOR]]\n");
       return a == "--help" || a == "-h" ? 0 : 2;
     }
   }
@@ -515,13 +529,13 @@ int main(int argc, char** argv) {
   b.mrsnake = fs::absolute(mrsnake_bin).string();
   b.keep_labels = keep;
   b.only = only;
-  if (!gac.empty()) {  // PROPAGATION,CURVATURE,ADVECTION[,BETA_FRACTION,ALPHA_DIVISOR]
+  if (!gac.empty()) {  // PROPAGATION,CURVATURE,ADVECTION[,SIGMA_MM,BETA_FRACTION,ALPHA_DIVISOR]
     auto& o = b.itk_options;
-    double* fields[] = {&o.gac_propagation, &o.gac_curvature, &o.gac_advection, &o.gac_beta_fraction,
-                        &o.gac_alpha_divisor};
+    double* fields[] = {&o.gac_propagation, &o.gac_curvature, &o.gac_advection, &o.gac_sigma_mm,
+                        &o.gac_beta_fraction, &o.gac_alpha_divisor};
     std::stringstream ss(gac);
     std::string item;
-    for (int k = 0; k < 5 && std::getline(ss, item, ','); ++k) *fields[k] = std::stod(item);
+    for (int k = 0; k < 6 && std::getline(ss, item, ','); ++k) *fields[k] = std::stod(item);
   }
   const bool temp_work = work.empty();
   b.work = temp_work ? fs::temp_directory_path() / ("bench_segment." + std::to_string(getpid())) : fs::path(work);

@@ -14,10 +14,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
 #include "mesh/errors.h"
+#include "mesh/image_io.h"
 
 namespace mrsnake::bench {
 namespace {
@@ -145,7 +147,7 @@ LevelSetRun geodesic_active_contour(const Volume& image, const Volume& init, con
 
   auto gradient = itk::GradientMagnitudeRecursiveGaussianImageFilter<FloatImage, FloatImage>::New();
   gradient->SetInput(to_itk(image));
-  gradient->SetSigma(o.sigma_mm);
+  gradient->SetSigma(o.gac_sigma_mm);
   gradient->Update();
   const float* g = gradient->GetOutput()->GetBufferPointer();
   // Gradient deep inside (noise and texture) and near the initial surface (where the edge is).
@@ -166,6 +168,11 @@ LevelSetRun geodesic_active_contour(const Volume& image, const Volume& init, con
   sigmoid->SetOutputMinimum(0.0f);
   sigmoid->SetOutputMaximum(1.0f);
   sigmoid->Update();
+  if (const char* dump = std::getenv("MRSNAKE_BENCH_DUMP_GAC")) {
+    Volume f = image;
+    std::copy(sigmoid->GetOutput()->GetBufferPointer(), sigmoid->GetOutput()->GetBufferPointer() + f.num_voxels(), f.data.begin());
+    write_volume(dump, f, VoxelType::float32);
+  }
 
   using Filter = itk::GeodesicActiveContourLevelSetImageFilter<FloatImage, FloatImage>;
   auto gac = Filter::New();
@@ -184,7 +191,7 @@ LevelSetRun geodesic_active_contour(const Volume& image, const Volume& init, con
   run.seconds = seconds_since(t_start);
   run.iterations = static_cast<int>(gac->GetElapsedIterations());
   run.rms_change = gac->GetRMSChange();
-  run.parameters_json = "{" + fmt("sigma_mm", o.sigma_mm) + ", " + fmt("sigmoid_alpha", alpha) + ", " +
+  run.parameters_json = "{" + fmt("sigma_mm", o.gac_sigma_mm) + ", " + fmt("sigmoid_alpha", alpha) + ", " +
                         fmt("sigmoid_beta", beta) + ", " + fmt("propagation", o.gac_propagation) + ", " +
                         fmt("curvature", o.gac_curvature) + ", " + fmt("advection", o.gac_advection) + ", " +
                         fmt("max_iterations", o.max_iterations) + ", " + fmt("max_rms_change", o.max_rms_change) + "}";

@@ -14,11 +14,12 @@ namespace mrsnake::bench {
 /// Parameters shared by both filters; every intensity-dependent value (sigmoid, thresholds)
 /// is derived from the image around the initial label, so the same options serve all cases.
 struct LevelSetOptions {
-  int max_iterations = 300;       ///< evolution steps at most
-  double max_rms_change = 0.002;  ///< stop when the RMS change of the level set falls below this
-  double sigma_mm = 1.0;          ///< Gaussian smoothing (GAC: gradient magnitude scale; threshold: feature image)
+  int max_iterations = 200;      ///< evolution steps at most (the start is a few voxels from the boundary)
+  double max_rms_change = 0.01;  ///< stop when the RMS change of the level set falls below this
+  double sigma_mm = 1.0;          ///< Gaussian smoothing of the threshold level set's feature image
+  double gac_sigma_mm = 1.5;      ///< scale of the GAC's gradient magnitude (recursive Gaussian)
   // Geodesic active contour: speed g = sigmoid(|∇(G_σ * I)|), edges → 0, flat regions → 1.
-  double gac_propagation = 1.0, gac_curvature = 1.0, gac_advection = 1.0;
+  double gac_propagation = 0.3, gac_curvature = 1.0, gac_advection = 1.0;
   /// Sigmoid: β = flat + gac_beta_fraction·(edge − flat), α = −(edge − flat)/gac_alpha_divisor,
   /// with flat the median gradient deep inside and edge its 90th percentile near the surface.
   double gac_beta_fraction = 0.35, gac_alpha_divisor = 12.0;
@@ -42,7 +43,7 @@ struct LevelSetRun {
 void set_itk_threads(int threads);
 
 /// Geodesic active contour (Caselles et al.) from the initial label `init` (non-zero inside).
-/// Feature image: sigmoid of the gradient magnitude (recursive Gaussian, sigma_mm); the
+/// Feature image: sigmoid of the gradient magnitude (recursive Gaussian, gac_sigma_mm); the
 /// sigmoid maps the typical gradient deep inside the initial label to ~1 and the 90th
 /// percentile of the gradient in a ±3 mm band around the initial surface to ~0 (see
 /// gac_beta_fraction and gac_alpha_divisor).
