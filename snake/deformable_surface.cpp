@@ -131,12 +131,17 @@ SnakeLevelReport DeformableSurface::run(RowMatrixX3d& V, const ExternalSearch& s
     // Apply, then undo (halve, then drop) the steps of vertices whose faces would flip.
     face_normals(V, F_, FN_old);
     RowMatrixX3d V_new = V + step;
-    for (int attempt = 0; attempt < 4; ++attempt) {
+    // Halve three times, then drop steps until no face folds (the previous iterate has no
+    // fold, so dropping every step terminates).
+    for (int attempt = 0; attempt < 3 + n; ++attempt) {
       face_normals(V_new, F_, FN_new);
       std::fill(flagged.begin(), flagged.end(), 0);
       bool any = false;
+      // A fold: a face turned against its normal at the level's start, or by more than
+      // 60° in one step (a step is at most a fraction of an edge, so only a fold does that).
       for (int f = 0; f < F_.rows(); ++f)
-        if (FN_old.row(f).dot(FN_new.row(f)) <= 0.0 && FN_old.row(f).squaredNorm() > 0) {
+        if ((FN_old.row(f).dot(FN_new.row(f)) < 0.5 && FN_old.row(f).squaredNorm() > 0) ||
+            (FN_start.row(f).dot(FN_new.row(f)) <= 0.0 && FN_start.row(f).squaredNorm() > 0)) {
           for (int k = 0; k < 3; ++k) flagged[F_(f, k)] = 1;
           any = true;
         }

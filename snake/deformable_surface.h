@@ -15,8 +15,8 @@
 ///  - external     w_e·o_v·n_v, o_v the matched offset along the normal, averaged over the
 ///                 1-ring to resist noise
 /// Each step x ← x + τ·F is capped to max_step_fraction·ℓ_v and to |o_v| + that cap along
-/// the normal. Faces whose normal would flip reject the step of their vertices (halved, then
-/// dropped). The run stops when the matched offsets and the energy stop changing.
+/// the normal. Faces that would turn against their normal at the level's start, or by more
+/// than 60° in one step, reject the step of their vertices (halved, then dropped). The run stops when the matched offsets and the energy stop changing.
 #include <functional>
 #include <limits>
 

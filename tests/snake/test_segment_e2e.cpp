@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <filesystem>
 #include <cstdio>
 
 #include "mesh/distance.h"
@@ -100,7 +101,7 @@ CaseOutcome run_case(SynthShape shape, std::uint64_t target_seed, std::uint64_t 
     for (const auto& l : r.levels) std::printf("  level %d volume ratio %.4f\n", l.level, enclosed_volume(l.surface) / enclosed_volume(target.truth_mesh));
     std::printf("vertex-to-truth: mean %.3f max %.3f, >1mm: %d of %d\n", d.mean(), d.maxCoeff(), over1, int(d.size()));
     const std::string dir = std::string("/tmp/e2e_") + to_string(shape);
-    std::system(("mkdir -p " + dir).c_str());
+    std::filesystem::create_directories(dir);
     write_mesh(dir + "/final.vtp", r.surface);
     write_mesh(dir + "/truth.vtp", target.truth_mesh);
     write_mesh(dir + "/model.vtp", TriMesh{model.levels.back(), model.faces(model.finest_level())});
@@ -194,5 +195,30 @@ TEST(SegmentCommand, WritesEveryOutputOnTheImageGridWithScores) {
                                               (dir / "nope.model").string() + " -o " + (dir / "seg2").string());
   EXPECT_EQ(bad.exit_code, 3) << bad.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "seg2"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(SegmentCommand, SynthBuildModelWithImageThenSegment) {
+  // The whole command-line path: two synthetic instances, a model with its appearance from
+  // the reference (remeshed by build-model), then segment with --truth.
+  const auto dir = mrsnake::test::scratch_dir("segment-roundtrip");
+  const std::string d = dir.string();
+  for (const auto& [name, seed] : {std::pair<std::string, int>{"ref", 22}, {"tgt", 21}}) {
+    const auto r = mrsnake::test::run_mrsnake("-q synth --shape blob --size 56 --snr 4 --pose random --deform 2 --seed " +
+                                              std::to_string(seed) + " -o " + d + "/" + name);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  const auto b = mrsnake::test::run_mrsnake("-q build-model --labels " + d + "/ref/truth.nii.gz --label 1 --image " + d +
+                                            "/ref/image.nii.gz -o " + d + "/blob.model --faces 8000");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const auto s = mrsnake::test::run_mrsnake("segment --image " + d + "/tgt/image.nii.gz --model " + d +
+                                            "/blob.model -o " + d + "/seg --truth " + d + "/tgt/truth.nii.gz --json -q");
+  ASSERT_EQ(s.exit_code, 0) << s.output;
+  const nlohmann::json rep = nlohmann::json::parse(s.output);
+  EXPECT_EQ(rep["force"], "profile");  // the model has an appearance
+  EXPECT_EQ(rep["self_intersections"], 0);
+  EXPECT_GE(rep["scores"]["dice"].get<double>(), 0.95);
+  std::printf("build-model --image + segment: Dice %.4f ASSD %.3f mm\n", rep["scores"]["dice"].get<double>(),
+              rep["scores"]["assd_mm"].get<double>());
   std::filesystem::remove_all(dir);
 }

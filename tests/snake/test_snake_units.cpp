@@ -344,3 +344,60 @@ TEST(Appearance, SerializationRoundTripsAndRejectsDamage) {
   bad[0] = 'X';
   EXPECT_THROW(deserialize_appearance(bad), InputError);
 }
+
+TEST(Snake, AdversarialTargetsNeverFlipAFace) {
+  // Targets alternate ±5 mm along the normals from vertex to vertex (a worst case a noisy
+  // search can produce): the steps that would flip a face are halved or dropped.
+  const TriMesh m = icosphere(3, 10.0);
+  SnakeOptions o;
+  o.external_weight = 1.0;
+  o.offset_smoothing = 0;
+  o.max_step_fraction = 1.0;
+  o.prior_weight = 0;
+  o.tangential_weight = 0;
+  o.thin_plate_weight = 0;
+  o.max_iterations = 20;
+  const DeformableSurface snake(m.F, m.V, o);
+  const ExternalSearch search = [](const RowMatrixX3d& V, const RowMatrixX3d&) {
+    SearchResult r;
+    r.offsets.resize(V.rows());
+    r.costs.setZero(V.rows());
+    for (int v = 0; v < V.rows(); ++v) r.offsets[v] = (v % 2 ? 5.0 : -5.0);
+    return r;
+  };
+  RowMatrixX3d V = m.V;
+  const SnakeLevelReport rep = snake.run(V, search, 0.5);
+  EXPECT_GT(rep.rejected_steps, 0);
+  EXPECT_EQ(rep.flipped_faces, 0);
+  RowMatrixX3d N0, N1;
+  face_normals(m.V, m.F, N0);
+  face_normals(V, m.F, N1);
+  for (int f = 0; f < m.num_faces(); ++f) EXPECT_GT(N0.row(f).dot(N1.row(f)), 0.0) << f;
+  // The trust region holds every vertex within its radius of the start.
+  RowMatrixX3d W = m.V;
+  snake.run(W, search, 0.5, 1.5);
+  EXPECT_LE((W - m.V).rowwise().norm().maxCoeff(), 1.5 + 1e-9);
+}
+
+TEST(Snake, ConvergesOntoASphereInAVolume) {
+  Volume image = make_grid({48, 48, 48}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
+  const Eigen::Vector3d c(24.2, 23.7, 24.4);
+  fill_object(image, [&](const Eigen::Vector3d& p) { return (p - c).norm() - 14.0; }, 1.0f, 0.0f, 3);
+  TriMesh m = icosphere(3, 11.0);
+  m.V.rowwise() += c.transpose();
+  const VolumeSampler s(image);
+  NormalSearchOptions so;
+  so.range_mm = 4;
+  so.step_mm = 0.5;
+  so.window_mm = 2;
+  const ExternalSearch search = [&](const RowMatrixX3d& V, const RowMatrixX3d& N) {
+    return search_step_edges(s, V, N, RegionStats{1.0, 0.0}, so);
+  };
+  const DeformableSurface snake(m.F, m.V, SnakeOptions{});
+  RowMatrixX3d V = m.V;
+  const SnakeLevelReport rep = snake.run(V, search, so.step_mm);
+  EXPECT_TRUE(rep.converged);
+  const Eigen::VectorXd radii = (V.rowwise() - c.transpose()).rowwise().norm();
+  EXPECT_NEAR(radii.mean(), 14.0, 0.15);  // the prior is scale invariant: no shrinkage
+  EXPECT_LT(radii.maxCoeff() - radii.minCoeff(), 0.6);
+}
