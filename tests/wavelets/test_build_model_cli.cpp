@@ -99,7 +99,9 @@ TEST(BuildModelCli, CloseTunnelsMakesAGenusOneLabelModelable) {
   const auto built =
       run_mrsnake("-q build-model --labels " + labels + " --label 4 -o " + model + " --faces 2048 --close-tunnels 6 --json");
   ASSERT_EQ(built.exit_code, 0) << built.output;
-  const nlohmann::json summary = nlohmann::json::parse(built.output);
+  // The repair is announced (a warning on stderr, before the JSON on stdout).
+  EXPECT_NE(built.output.find("closed its tunnels"), std::string::npos) << built.output;
+  const nlohmann::json summary = nlohmann::json::parse(built.output.substr(built.output.find('{')));
   EXPECT_GE(summary["closing_radius_voxels"].get<int>(), 1);
   EXPECT_LE(summary["closing_radius_voxels"].get<int>(), 6);
   const ShapeModel m = load_model(model, {true});
