@@ -20,7 +20,7 @@ void add_build_model_command(CLI::App& app) {
                                  "semi-regular remeshing, lifting-wavelet analysis");
   struct Args {
     std::string labels, output, predict = "butterfly", image;
-    int label = 1, levels = 0, faces = 32768, smooth = 20;
+    int label = 1, levels = 0, faces = 32768, smooth = 20, close_tunnels = 0;
     bool full_report = false, json = false;
   };
   auto a = std::make_shared<Args>();
@@ -35,6 +35,10 @@ void add_build_model_command(CLI::App& app) {
       ->check(CLI::IsMember({"butterfly", "linear"}));
   cmd->add_option("--smooth", a->smooth, "Windowed-sinc smoothing iterations of the marching-cubes surface (default 20; 0 = none)")
       ->check(CLI::Range(0, 1000));
+  cmd->add_option("--close-tunnels", a->close_tunnels,
+                  "If the label's surface is not genus 0, close the label with radii up to this many voxels until it "
+                  "is (as 'mrsnake mc --close-tunnels'); 0 = no repair")
+      ->check(CLI::Range(0, 20));
   cmd->add_option("--image", a->image,
                   "Reference intensity image of the labels (same physical space): stores the appearance "
                   "(profiles along the normals, inside/outside statistics) that 'mrsnake segment' matches");
@@ -42,7 +46,8 @@ void add_build_model_command(CLI::App& app) {
   cmd->add_flag("--json", a->json, "Print a JSON summary");
   cmd->footer(
       "Example: mrsnake build-model --labels liver-labels.nii.gz --label 255 --image liver.nii.gz -o liver.model "
-      "--faces 32768");
+      "--faces 32768\n"
+      "A label with tunnels (genus > 0): add --close-tunnels 3, e.g. the liver of abdomen-ct-small-seg.nii.gz (label 5).");
   cmd->callback([a] {
     using clock = std::chrono::steady_clock;
     const auto progress = terminal_progress();
@@ -61,10 +66,14 @@ void add_build_model_command(CLI::App& app) {
 
     LabelSurfaceOptions mc;
     mc.smoothing_iterations = a->smooth;
+    mc.max_closing_radius = a->close_tunnels;
     const LabelSurface surface = extract_label_surface(labels, a->label, mc, progress);
     if (!surface.dropped_component_faces.empty())
       warn("label " + std::to_string(a->label) + " has " + std::to_string(surface.components_found) +
            " connected surfaces; the model uses the largest");
+    if (surface.closing_radius > 0)
+      warn("label " + std::to_string(a->label) + " had a genus-" + std::to_string(surface.genus_before_repair) +
+           " surface; closed its tunnels with a radius of " + std::to_string(surface.closing_radius) + " voxels");
     lap("marching_cubes");
 
     RemeshOptions ro;
@@ -127,6 +136,7 @@ void add_build_model_command(CLI::App& app) {
                   {"vertex_counts", conn.vertex_counts},
                   {"faces", conn.faces.back().rows()},
                   {"input_faces", surface.mesh.num_faces()},
+                  {"closing_radius_voxels", surface.closing_radius},
                   {"finest_level_quality", quality["finest_level_quality"]},
                   {"detail_stats", stats},
                   {"timings", stages},

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 #include "mesh/image_io.h"
@@ -70,4 +72,43 @@ TEST(BuildModelCli, BadInputsGetExitCodes) {
   EXPECT_EQ(run_mrsnake("-q build-model --labels " + (dir / "none.nii.gz").string() + " --label 3 -o " + model).exit_code, 3);
   EXPECT_EQ(run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --predict cubic").exit_code, 2);
   EXPECT_EQ(run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --levels 3 --faces 100").exit_code, 2);
+}
+
+TEST(BuildModelCli, CloseTunnelsMakesAGenusOneLabelModelable) {
+  // A torus (major radius 9, minor 5.5 voxels; its hole has radius 3.5): genus 1, which the
+  // remesher refuses, unless --close-tunnels fills the hole first.
+  const auto dir = scratch_dir("build-model-cli-torus");
+  Volume v;
+  v.size = {40, 40, 40};
+  v.data.assign(v.num_voxels(), 0.0f);
+  for (std::size_t k = 0; k < 40; ++k)
+    for (std::size_t j = 0; j < 40; ++j)
+      for (std::size_t i = 0; i < 40; ++i) {
+        const double x = i - 19.5, y = j - 19.5, z = k - 19.5;
+        const double ring = std::hypot(x, y) - 9.0;
+        if (ring * ring + z * z <= 5.5 * 5.5) v.at(i, j, k) = 4.0f;
+      }
+  const std::string labels = (dir / "torus.nii.gz").string();
+  write_volume(labels, v, VoxelType::uint8);
+  const std::string model = (dir / "torus.model").string();
+
+  const auto refused = run_mrsnake("-q build-model --labels " + labels + " --label 4 -o " + model + " --faces 2048");
+  EXPECT_NE(refused.exit_code, 0) << refused.output;
+  EXPECT_FALSE(std::filesystem::exists(model));
+
+  const auto built =
+      run_mrsnake("-q build-model --labels " + labels + " --label 4 -o " + model + " --faces 2048 --close-tunnels 6 --json");
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  // The repair is announced (a warning on stderr, before the JSON on stdout).
+  EXPECT_NE(built.output.find("closed its tunnels"), std::string::npos) << built.output;
+  const nlohmann::json summary = nlohmann::json::parse(built.output.substr(built.output.find('{')));
+  EXPECT_GE(summary["closing_radius_voxels"].get<int>(), 1);
+  EXPECT_LE(summary["closing_radius_voxels"].get<int>(), 6);
+  const ShapeModel m = load_model(model, {true});
+  EXPECT_EQ(m.levels(), summary["levels"].get<int>());
+
+  // Too small a radius leaves the tunnel open, and the build still refuses it.
+  EXPECT_NE(run_mrsnake("-q build-model --labels " + labels + " --label 4 -o " + model + "-r1 --faces 2048 --close-tunnels 1")
+                .exit_code,
+            0);
 }
