@@ -28,6 +28,17 @@ std::string cell(const nlohmann::json& j, const char* key, int digits) {
   return fixed(j[key].get<double>(), digits);
 }
 
+/// A setting's value as text: strings as they are, numbers with 4 significant digits.
+std::string setting(const nlohmann::json& v) {
+  if (v.is_string()) return v.get<std::string>();
+  if (v.is_number_float()) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.4g", v.get<double>());
+    return buf;
+  }
+  return v.dump();
+}
+
 /// Quality and distance of one level: from its stats when remesh computed them, else
 /// computed here (distance only when the input is known).
 std::pair<nlohmann::json, nlohmann::json> level_figures(const RemeshResult& result, int j, const TriMesh* input) {
@@ -119,11 +130,11 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
   settings.push_back({"faces (finest)", std::to_string(result.connectivity.faces.back().rows())});
   settings.push_back({"base vertices n0", std::to_string(result.levels.front().positions.rows())});
   for (const char* key : {"input", "relax", "density_exponent", "lloyd_iterations", "shape_iterations"})
-    if (r.is_object() && r.contains(key)) settings.push_back({key, r[key].is_string() ? r[key].get<std::string>() : r[key].dump()});
+    if (r.is_object() && r.contains(key)) settings.push_back({key, setting(r[key])});
   if (result.parameterization.is_object())
     for (const auto& [key, value] : result.parameterization.items())
       if (!value.is_structured())
-        settings.push_back({"parameterization " + key, value.is_string() ? value.get<std::string>() : value.dump()});
+        settings.push_back({"parameterization " + key, setting(value)});
   if (options.input)
     settings.push_back({"input faces", std::to_string(options.input->num_faces())});
   page.heading("Settings");
@@ -156,9 +167,13 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
   if (unrelaxed) add_rows(*unrelaxed, "unrelaxed");
   if (unrelaxed)  // side by side: sort by level, relaxed first
     std::stable_sort(rows.begin(), rows.end(), [](const auto& a, const auto& b) { return std::stoi(a[0]) < std::stoi(b[0]); });
-  page.table({"level", "variant", "vertices", "faces", "RMS error %", "Hausdorff %", "angle variance (deg²)",
-              "min angle (°)", "edge length variance", "Q min", "Q mean", "valence 6 %", "flipped in D"},
-             rows);
+  std::vector<std::string> header = {"level", "variant", "vertices", "faces", "RMS error %", "Hausdorff %", "angle variance (deg²)",
+              "min angle (°)", "edge length variance", "Q min", "Q mean", "valence 6 %", "flipped in D"};
+  if (!unrelaxed) {  // one variant: no column for it
+    header.erase(header.begin() + 1);
+    for (auto& row : rows) row.erase(row.begin() + 1);
+  }
+  page.table(header, rows);
   if (distance_missing) page.note("The geometric error needs the input surface; it was not given to this page.");
 
   // Renders of every level.
