@@ -38,5 +38,6 @@ void add_synth_command(CLI::App& app);
 void add_evaluate_command(CLI::App& app);
 void add_remesh_command(CLI::App& app);
 void add_build_model_command(CLI::App& app);
+void add_segment_command(CLI::App& app);
 
 }  // namespace mrsnake::cli

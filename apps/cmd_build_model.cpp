@@ -13,6 +13,7 @@
 #include "mesh/marching_cubes.h"
 #include "mesh/quality.h"
 #include "remesh/remesh.h"
+#include "snake/model_bridge.h"
 #include "wavelets/model_io.h"
 
 namespace mrsnake::cli {
@@ -22,7 +23,7 @@ void add_build_model_command(CLI::App& app) {
                                  "Build a multiresolution shape model from one label of a label image: marching cubes, "
                                  "semi-regular remeshing, lifting-wavelet analysis");
   struct Args {
-    std::string labels, output, predict = "butterfly";
+    std::string labels, output, predict = "butterfly", image;
     int label = 1, levels = 0, faces = 32768, smooth = 20;
     bool full_report = false, json = false, compare_unrelaxed = false;
   };
@@ -38,11 +39,16 @@ void add_build_model_command(CLI::App& app) {
       ->check(CLI::IsMember({"butterfly", "linear"}));
   cmd->add_option("--smooth", a->smooth, "Windowed-sinc smoothing iterations of the marching-cubes surface (default 20; 0 = none)")
       ->check(CLI::Range(0, 1000));
+  cmd->add_option("--image", a->image,
+                  "Reference intensity image of the labels (same physical space): stores the appearance "
+                  "(profiles along the normals, inside/outside statistics) that 'mrsnake segment' matches");
   cmd->add_flag("--full-report", a->full_report, "Quality and distance to the input at every level (slower)");
   cmd->add_flag("--compare-unrelaxed", a->compare_unrelaxed,
                 "Also remesh without relaxation and compare both in MODEL/report.html (a second remeshing run)");
   cmd->add_flag("--json", a->json, "Print a JSON summary");
-  cmd->footer("Example: mrsnake build-model --labels liver-labels.nii.gz --label 255 -o liver.model --faces 32768");
+  cmd->footer(
+      "Example: mrsnake build-model --labels liver-labels.nii.gz --label 255 --image liver.nii.gz -o liver.model "
+      "--faces 32768");
   cmd->callback([a] {
     using clock = std::chrono::steady_clock;
     const auto progress = terminal_progress();
@@ -88,6 +94,12 @@ void add_build_model_command(CLI::App& app) {
     ShapeModel model = make_model(hierarchy.connectivity, hierarchy.levels.back().positions, wo);
     report(progress, "wavelet analysis", 1.0);
     lap("analysis");
+
+    if (!a->image.empty()) {
+      report(progress, "appearance", 0.0);
+      add_appearance(model, read_volume(a->image));
+      lap("appearance");
+    }
 
     model.source_image = a->labels;
     model.source_label = a->label;

@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   cli::add_evaluate_command(app);
   cli::add_remesh_command(app);
   cli::add_build_model_command(app);
+  cli::add_segment_command(app);
 
   try {
     app.parse(argc, argv);

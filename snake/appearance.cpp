@@ -1,0 +1,176 @@
+#include "snake/appearance.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include <nlohmann/json.hpp>
+
+#include "mesh/errors.h"
+#include "snake/sampler.h"
+#include "snake/surface_geometry.h"
+
+namespace mrsnake {
+
+int pyramid_level_for_edge(double edge_mm, const std::vector<double>& spacings, double edge_per_voxel) {
+  const double target = edge_mm / edge_per_voxel;
+  int best = 0;
+  double best_d = std::numeric_limits<double>::max();
+  for (int k = 0; k < static_cast<int>(spacings.size()); ++k) {
+    const double d = std::abs(std::log(spacings[k] / target));
+    if (d < best_d - 1e-9) {
+      best_d = d;
+      best = k;
+    }
+  }
+  return best;
+}
+
+double mean_edge_length(const RowMatrixX3d& V, const RowMatrixX3i& F) {
+  double sum = 0;
+  for (int f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) sum += (V.row(F(f, c)) - V.row(F(f, (c + 1) % 3))).norm();
+  return F.rows() ? sum / (3.0 * F.rows()) : 0.0;
+}
+
+namespace {
+double max_spacing(const Volume& v) { return std::max({v.spacing[0], v.spacing[1], v.spacing[2]}); }
+
+void median_and_spread(std::vector<float>& a, double& median, double& spread) {
+  if (a.empty()) {
+    median = spread = 0;
+    return;
+  }
+  const std::size_t mid = a.size() / 2;
+  std::nth_element(a.begin(), a.begin() + static_cast<long>(mid), a.end());
+  median = a[mid];
+  for (float& x : a) x = static_cast<float>(std::abs(x - median));
+  std::nth_element(a.begin(), a.begin() + static_cast<long>(mid), a.end());
+  spread = 1.4826 * a[mid];
+}
+}  // namespace
+
+Appearance build_appearance(const std::vector<Volume>& pyramid, const std::vector<RowMatrixX3d>& levels,
+                            const std::vector<RowMatrixX3i>& faces, const AppearanceOptions& options) {
+  Appearance a;
+  a.half_length = options.half_length;
+  std::vector<double> spacings;
+  for (const Volume& v : pyramid) spacings.push_back(max_spacing(v));
+  RowMatrixX3d N;
+  for (std::size_t j = 0; j < levels.size(); ++j) {
+    const int p = pyramid_level_for_edge(mean_edge_length(levels[j], faces[j]), spacings);
+    const VolumeSampler sampler(pyramid[p]);
+    vertex_normals(levels[j], faces[j], N);
+    LevelAppearance la;
+    la.spacing_mm = spacings[p];
+    la.profiles = sample_profiles(sampler, levels[j], N, options.half_length, la.spacing_mm);
+    a.levels.push_back(std::move(la));
+  }
+  // Region statistics on the finest level, at full resolution.
+  const VolumeSampler sampler(pyramid[0]);
+  const RowMatrixX3d& V = levels.back();
+  vertex_normals(V, faces.back(), N);
+  const double h = 0.5 * max_spacing(pyramid[0]);
+  a.shell_mm = options.shell_voxels * max_spacing(pyramid[0]);
+  const int steps = std::max(1, static_cast<int>(std::floor(a.shell_mm / h)));
+  std::vector<float> in, out;
+  for (int v = 0; v < V.rows(); ++v) {
+    const Eigen::Vector3d x = V.row(v), n = N.row(v);
+    for (int s = 1; s <= steps; ++s) {
+      in.push_back(sampler.value(x - (s * h) * n));
+      out.push_back(sampler.value(x + (s * h) * n));
+    }
+  }
+  median_and_spread(in, a.region.inside, a.inside_spread);
+  median_and_spread(out, a.region.outside, a.outside_spread);
+  return a;
+}
+
+namespace {
+constexpr char kMagic[8] = {'M', 'R', 'S', 'A', 'P', 'P', '0', '1'};
+
+template <class T>
+void put(std::vector<std::uint8_t>& b, const T& x) {
+  const auto* p = reinterpret_cast<const std::uint8_t*>(&x);
+  b.insert(b.end(), p, p + sizeof(T));
+}
+
+struct Reader {
+  const std::vector<std::uint8_t>& b;
+  std::size_t pos = 0;
+  template <class T>
+  T get() {
+    if (pos + sizeof(T) > b.size())
+      throw InputError("the model's appearance section is truncated; rebuild the model with build-model --image");
+    T x;
+    std::memcpy(&x, b.data() + pos, sizeof(T));
+    pos += sizeof(T);
+    return x;
+  }
+};
+}  // namespace
+
+std::vector<std::uint8_t> serialize_appearance(const Appearance& a) {
+  std::vector<std::uint8_t> b(kMagic, kMagic + 8);
+  put<std::int32_t>(b, a.half_length);
+  put<std::int32_t>(b, static_cast<std::int32_t>(a.levels.size()));
+  put<double>(b, a.region.inside);
+  put<double>(b, a.region.outside);
+  put<double>(b, a.inside_spread);
+  put<double>(b, a.outside_spread);
+  put<double>(b, a.shell_mm);
+  for (const LevelAppearance& l : a.levels) {
+    put<double>(b, l.spacing_mm);
+    put<std::int32_t>(b, static_cast<std::int32_t>(l.profiles.rows()));
+    put<std::int32_t>(b, static_cast<std::int32_t>(l.profiles.cols()));
+    for (int r = 0; r < l.profiles.rows(); ++r)
+      for (int c = 0; c < l.profiles.cols(); ++c) put<float>(b, l.profiles(r, c));
+  }
+  return b;
+}
+
+Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes) {
+  if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0)
+    throw InputError("the model's appearance section is not in a format this build reads; rebuild the model");
+  Reader r{bytes, 8};
+  Appearance a;
+  a.half_length = r.get<std::int32_t>();
+  const int levels = r.get<std::int32_t>();
+  if (a.half_length < 0 || a.half_length > 1000 || levels < 0 || levels > 64)
+    throw InputError("the model's appearance section is inconsistent; rebuild the model");
+  a.region.inside = r.get<double>();
+  a.region.outside = r.get<double>();
+  a.inside_spread = r.get<double>();
+  a.outside_spread = r.get<double>();
+  a.shell_mm = r.get<double>();
+  for (int j = 0; j < levels; ++j) {
+    LevelAppearance l;
+    l.spacing_mm = r.get<double>();
+    const int rows = r.get<std::int32_t>(), cols = r.get<std::int32_t>();
+    if (rows < 0 || cols != 2 * a.half_length + 1 || !(l.spacing_mm > 0) ||
+        static_cast<std::size_t>(rows) * cols * sizeof(float) > bytes.size() - r.pos)
+      throw InputError("the model's appearance section is inconsistent; rebuild the model");
+    l.profiles.resize(rows, cols);
+    for (int i = 0; i < rows; ++i)
+      for (int c = 0; c < cols; ++c) l.profiles(i, c) = r.get<float>();
+    a.levels.push_back(std::move(l));
+  }
+  if (r.pos != bytes.size()) throw InputError("the model's appearance section has trailing bytes; rebuild the model");
+  return a;
+}
+
+void to_json(nlohmann::json& j, const Appearance& a) {
+  j = nlohmann::json{{"levels", a.levels.size()},
+                     {"samples_per_profile", 2 * a.half_length + 1},
+                     {"inside_median", a.region.inside},
+                     {"outside_median", a.region.outside},
+                     {"inside_spread", a.inside_spread},
+                     {"outside_spread", a.outside_spread},
+                     {"shell_mm", a.shell_mm}};
+  nlohmann::json spacing = nlohmann::json::array();
+  for (const auto& l : a.levels) spacing.push_back(l.spacing_mm);
+  j["profile_spacing_mm"] = spacing;
+}
+
+}  // namespace mrsnake

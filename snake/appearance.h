@@ -1,0 +1,59 @@
+#pragma once
+/// \file appearance.h
+/// What the organ looks like in the reference image, stored with the model: per level, the
+/// intensity profile along the normal at each vertex (as in active shape models), and the
+/// intensity statistics inside the object and in a shell outside it. Intensities are those
+/// of the robustly normalized image (image_pyramid.h), so they compare across scans.
+#include <cstdint>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "mesh/trimesh.h"
+#include "mesh/volume.h"
+#include "snake/forces.h"
+
+namespace mrsnake {
+
+/// The profiles of one level of the hierarchy.
+struct LevelAppearance {
+  double spacing_mm = 1;      ///< distance between profile samples (the pyramid voxel size used)
+  Eigen::MatrixXf profiles;   ///< n_j × K, sample k at offset (k − K/2)·spacing_mm along the normal
+};
+
+struct Appearance {
+  int half_length = 5;             ///< K = 2·half_length + 1 samples per profile
+  std::vector<LevelAppearance> levels;
+  RegionStats region;              ///< medians inside and in a shell outside (normalized units)
+  double inside_spread = 0, outside_spread = 0;  ///< robust spreads (1.4826·MAD)
+  double shell_mm = 0;             ///< thickness of the shells the statistics come from
+};
+
+struct AppearanceOptions {
+  int half_length = 5;
+  double shell_voxels = 3;  ///< statistics shell thickness, in voxels of the full-resolution image
+};
+
+/// Picks the pyramid level for a mesh level: the one whose largest voxel size is closest
+/// (in log scale) to edge_mm / edge_per_voxel.
+/// \pre pyramid_spacings is not empty.
+int pyramid_level_for_edge(double edge_mm, const std::vector<double>& pyramid_spacings, double edge_per_voxel = 2.0);
+
+/// Mean edge length of a mesh.
+double mean_edge_length(const RowMatrixX3d& V, const RowMatrixX3i& F);
+
+/// Learns the appearance of every level S_j (faces F_j, in the reference image's physical
+/// space) from the normalized reference image's pyramid (pyramid[0] full resolution).
+/// \pre levels.size() == faces.size(); pyramid not empty.
+Appearance build_appearance(const std::vector<Volume>& pyramid, const std::vector<RowMatrixX3d>& levels,
+                            const std::vector<RowMatrixX3i>& faces, const AppearanceOptions& options = {});
+
+/// Binary form (little-endian, versioned), for the model's optional "appearance" section.
+std::vector<std::uint8_t> serialize_appearance(const Appearance& appearance);
+/// \throw InputError if the bytes are truncated, of another version or inconsistent.
+Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes);
+
+/// Summary for reports: levels, samples per profile, region statistics.
+void to_json(nlohmann::json& j, const Appearance& a);
+
+}  // namespace mrsnake

@@ -1,0 +1,165 @@
+#include "snake/deformable_surface.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+
+namespace mrsnake {
+
+Eigen::VectorXd relative_normal_umbrella(const VertexRings& rings, const RowMatrixX3i& F, const RowMatrixX3d& model_V) {
+  RowMatrixX3d N, U;
+  Eigen::VectorXd L;
+  vertex_normals(model_V, F, N);
+  umbrella(rings, model_V, U);
+  ring_edge_lengths(rings, model_V, L);
+  Eigen::VectorXd h(model_V.rows());
+  for (int v = 0; v < model_V.rows(); ++v) h[v] = L[v] > 0 ? U.row(v).dot(N.row(v)) / L[v] : 0.0;
+  return h;
+}
+
+DeformableSurface::DeformableSurface(RowMatrixX3i F, const RowMatrixX3d& model_V, SnakeOptions options)
+    : F_(std::move(F)), rings_(build_vertex_rings(F_, static_cast<int>(model_V.rows()))), options_(options) {
+  prior_ = relative_normal_umbrella(rings_, F_, model_V);
+}
+
+namespace {
+struct InternalTerms {
+  RowMatrixX3d force;
+  double energy = 0;
+};
+
+InternalTerms compute_internal(const VertexRings& rings, const RowMatrixX3i& F, const Eigen::VectorXd& prior,
+                               const SnakeOptions& o, const RowMatrixX3d& V, const RowMatrixX3d& N) {
+  const int n = static_cast<int>(V.rows());
+  RowMatrixX3d U;
+  Eigen::VectorXd L;
+  umbrella(rings, V, U);
+  ring_edge_lengths(rings, V, L);
+  (void)F;
+  InternalTerms t;
+  t.force.resize(n, 3);
+  RowMatrixX3d residual(n, 3);
+  double energy = 0;
+  for (int v = 0; v < n; ++v) {
+    const Eigen::Vector3d nv = N.row(v), uv = U.row(v);
+    const double h = uv.dot(nv);
+    const double rel = h - prior[v] * L[v];
+    residual.row(v) = rel * nv;
+    t.force.row(v) = (o.membrane_weight * h + o.prior_weight * rel) * nv + o.tangential_weight * (uv - h * nv);
+    if (L[v] > 0) energy += 0.5 * (o.prior_weight * rel * rel + o.membrane_weight * h * h) / (L[v] * L[v]);
+  }
+  if (o.thin_plate_weight > 0) {
+    for (int v = 0; v < n; ++v) {
+      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+      for (int k = rings.offsets[v]; k < rings.offsets[v + 1]; ++k) mean += residual.row(rings.neighbors[k]).transpose();
+      const int val = rings.valence(v);
+      if (val > 0) t.force.row(v) -= o.thin_plate_weight * (mean / val - residual.row(v).transpose()).transpose();
+    }
+  }
+  t.energy = n > 0 ? energy / n : 0.0;
+  return t;
+}
+}  // namespace
+
+RowMatrixX3d DeformableSurface::internal_forces(const RowMatrixX3d& V) const {
+  RowMatrixX3d N;
+  vertex_normals(V, F_, N);
+  return compute_internal(rings_, F_, prior_, options_, V, N).force;
+}
+
+SnakeLevelReport DeformableSurface::run(RowMatrixX3d& V, const ExternalSearch& search, double search_step_mm,
+                                       double max_displacement_mm) const {
+  const SnakeOptions& o = options_;
+  const int n = static_cast<int>(V.rows());
+  SnakeLevelReport report;
+  RowMatrixX3d N, FN_start, FN_old, FN_new, step(n, 3);
+  Eigen::VectorXd L;
+  face_normals(V, F_, FN_start);
+  const RowMatrixX3d V_start = V;
+  std::deque<double> offset_history, energy_history;
+  std::vector<char> flagged(static_cast<std::size_t>(n));
+  for (int it = 0; it < o.max_iterations; ++it) {
+    vertex_normals(V, F_, N);
+    ring_edge_lengths(rings_, V, L);
+    SearchResult found = search(V, N);
+    Eigen::VectorXd offsets = found.offsets;
+    smooth_on_rings(rings_, offsets, o.offset_smoothing);
+    const InternalTerms internal = compute_internal(rings_, F_, prior_, o, V, N);
+    report.external_energy = found.costs.size() ? found.costs.mean() : 0.0;
+    report.internal_energy = internal.energy;
+    report.energy = report.external_energy + report.internal_energy;
+    report.mean_abs_offset_mm = offsets.size() ? offsets.cwiseAbs().mean() : 0.0;
+    report.iterations = it;
+
+    // Convergence on the matched offsets and the energy, not on raw vertex motion.
+    offset_history.push_back(report.mean_abs_offset_mm);
+    energy_history.push_back(report.energy);
+    if (static_cast<int>(offset_history.size()) > o.patience + 1) {
+      offset_history.pop_front();
+      energy_history.pop_front();
+    }
+    if (it >= o.min_iterations && static_cast<int>(offset_history.size()) == o.patience + 1) {
+      const auto [omin, omax] = std::minmax_element(offset_history.begin(), offset_history.end());
+      const auto [emin, emax] = std::minmax_element(energy_history.begin(), energy_history.end());
+      const bool offsets_settled = (*omax - *omin) < o.tolerance * search_step_mm;
+      const bool energy_settled = (*emax - *emin) < o.tolerance * std::max(1e-9, std::abs(*emax));
+      if (offsets_settled && energy_settled) {
+        report.converged = true;
+        break;
+      }
+    }
+
+    for (int v = 0; v < n; ++v) {
+      const Eigen::Vector3d nv = N.row(v);
+      Eigen::Vector3d s = o.time_step * (internal.force.row(v).transpose() + o.external_weight * offsets[v] * nv);
+      // Along the normal, never move past the matched offset (plus a small slack); in all
+      // directions, at most a fraction of the local edge length.
+      const double cap = o.max_step_fraction * L[v];
+      const double along = s.dot(nv);
+      const double limit = std::abs(offsets[v]) + 0.25 * cap;
+      if (std::abs(along) > limit) s -= (along - std::copysign(limit, along)) * nv;
+      const double len = s.norm();
+      if (len > cap && len > 0) s *= cap / len;
+      // Trust region around the level's start.
+      const Eigen::Vector3d start = V_start.row(v).transpose();
+      const Eigen::Vector3d moved = V.row(v).transpose() + s - start;
+      const double dist = moved.norm();
+      if (dist > max_displacement_mm) s = start + moved * (max_displacement_mm / dist) - V.row(v).transpose();
+      step.row(v) = s.transpose();
+    }
+
+    // Apply, then undo (halve, then drop) the steps of vertices whose faces would flip.
+    face_normals(V, F_, FN_old);
+    RowMatrixX3d V_new = V + step;
+    // Halve three times, then drop steps until no face folds (the previous iterate has no
+    // fold, so dropping every step terminates).
+    for (int attempt = 0; attempt < 3 + n; ++attempt) {
+      face_normals(V_new, F_, FN_new);
+      std::fill(flagged.begin(), flagged.end(), 0);
+      bool any = false;
+      // A fold: a face turned against its normal at the level's start, or by more than
+      // 60° in one step (a step is at most a fraction of an edge, so only a fold does that).
+      for (int f = 0; f < F_.rows(); ++f)
+        if ((FN_old.row(f).dot(FN_new.row(f)) < 0.5 && FN_old.row(f).squaredNorm() > 0) ||
+            (FN_start.row(f).dot(FN_new.row(f)) <= 0.0 && FN_start.row(f).squaredNorm() > 0)) {
+          for (int k = 0; k < 3; ++k) flagged[F_(f, k)] = 1;
+          any = true;
+        }
+      if (!any) break;
+      for (int v = 0; v < n; ++v)
+        if (flagged[v]) {
+          ++report.rejected_steps;
+          step.row(v) *= attempt < 3 ? 0.5 : 0.0;
+          V_new.row(v) = V.row(v) + step.row(v);
+        }
+    }
+    V.swap(V_new);
+    report.iterations = it + 1;
+  }
+  face_normals(V, F_, FN_new);
+  for (int f = 0; f < F_.rows(); ++f)
+    if (FN_start.row(f).dot(FN_new.row(f)) < 0) ++report.flipped_faces;
+  return report;
+}
+
+}  // namespace mrsnake

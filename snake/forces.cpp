@@ -1,0 +1,150 @@
+#include "snake/forces.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace mrsnake {
+
+Eigen::MatrixXf sample_profiles(const VolumeSampler& image, const RowMatrixX3d& V, const RowMatrixX3d& N, int half,
+                                double spacing_mm) {
+  const int K = 2 * half + 1;
+  Eigen::MatrixXf P(V.rows(), K);
+  for (int v = 0; v < V.rows(); ++v) {
+    const Eigen::Vector3d x = V.row(v), n = N.row(v);
+    for (int k = 0; k < K; ++k) P(v, k) = image.value(x + ((k - half) * spacing_mm) * n);
+  }
+  return P;
+}
+
+namespace {
+// Parabolic refinement of the minimum at index i of costs c (uniform spacing h).
+double refine(const std::vector<double>& c, int i, double h) {
+  if (i <= 0 || i + 1 >= static_cast<int>(c.size())) return 0.0;
+  const double a = c[i - 1], b = c[i], d = c[i + 1];
+  const double denom = a - 2 * b + d;
+  if (!(denom > 0)) return 0.0;
+  return std::clamp(0.5 * (a - d) / denom, -0.5, 0.5) * h;
+}
+}  // namespace
+
+SearchResult search_step_edges(const VolumeSampler& image, const RowMatrixX3d& V, const RowMatrixX3d& N,
+                               const RegionStats& stats, const NormalSearchOptions& options) {
+  const double h = options.step_mm;
+  const int nc = std::max(0, static_cast<int>(std::floor(options.range_mm / h)));  // candidates −nc..nc
+  const int w = std::max(1, static_cast<int>(std::lround(options.window_mm / h)));  // samples per side
+  const int ns = 2 * (nc + w);  // samples at offsets (s − nc − w + 0.5)·h, s = 0..ns−1
+  const double contrast2 = std::max(1e-12, (stats.inside - stats.outside) * (stats.inside - stats.outside));
+  const double norm = 1.0 / (2.0 * w * contrast2);
+  SearchResult r;
+  r.offsets.setZero(V.rows());
+  r.costs.setZero(V.rows());
+  std::vector<double> in_prefix(ns + 1), out_prefix(ns + 1), cost(2 * nc + 1);
+  for (int v = 0; v < V.rows(); ++v) {
+    const Eigen::Vector3d x = V.row(v), n = N.row(v);
+    in_prefix[0] = out_prefix[0] = 0;
+    for (int s = 0; s < ns; ++s) {
+      const double t = (s - nc - w + 0.5) * h;
+      const double I = image.value(x + t * n);
+      in_prefix[s + 1] = in_prefix[s] + (I - stats.inside) * (I - stats.inside);
+      out_prefix[s + 1] = out_prefix[s] + (I - stats.outside) * (I - stats.outside);
+    }
+    int best = nc;
+    for (int c = 0; c <= 2 * nc; ++c) {
+      // Candidate boundary at offset (c − nc)·h lies between samples c + w − 1 and c + w.
+      const int mid = c + w;
+      const double misfit = (in_prefix[mid] - in_prefix[mid - w]) + (out_prefix[mid + w] - out_prefix[mid]);
+      const double t = (c - nc) * h;
+      const double rel = options.range_mm > 0 ? t / options.range_mm : 0.0;
+      cost[c] = misfit * norm + options.distance_penalty * rel * rel;
+      if (cost[c] < cost[best]) best = c;
+    }
+    r.offsets[v] = cost[best] <= options.max_cost ? (best - nc) * h + refine(cost, best, h) : 0.0;
+    r.costs[v] = cost[best];
+  }
+  return r;
+}
+
+SearchResult search_profiles(const VolumeSampler& image, const RowMatrixX3d& V, const RowMatrixX3d& N,
+                             const Eigen::MatrixXf& profiles, double profile_spacing_mm,
+                             const NormalSearchOptions& options) {
+  const int K = static_cast<int>(profiles.cols());
+  const int half = K / 2;
+  // Samples and candidates on a grid `sub` times finer than the profile spacing: the
+  // profile's k-th sample of candidate c is sample c + sub·k.
+  const int sub = std::max(1, static_cast<int>(std::lround(profile_spacing_mm / options.step_mm)));
+  const double h = profile_spacing_mm / sub;
+  const int nc = std::max(0, static_cast<int>(std::floor(options.range_mm / h)));
+  const int ns = 2 * nc + sub * (K - 1) + 1;  // samples at offsets (s − nc − sub·half)·h
+  SearchResult r;
+  r.offsets.setZero(V.rows());
+  r.costs.setZero(V.rows());
+  std::vector<double> samples(ns), cost(2 * nc + 1);
+  std::vector<double> model(K);
+  for (int v = 0; v < V.rows(); ++v) {
+    // The learned profile, centred and scaled to unit norm.
+    double mean = 0;
+    for (int k = 0; k < K; ++k) mean += profiles(v, k);
+    mean /= K;
+    double norm2 = 0;
+    for (int k = 0; k < K; ++k) {
+      model[k] = profiles(v, k) - mean;
+      norm2 += model[k] * model[k];
+    }
+    if (!(norm2 > 1e-12)) {  // a flat learned profile carries no information
+      r.offsets[v] = 0;
+      r.costs[v] = 1;
+      continue;
+    }
+    const double inv = 1.0 / std::sqrt(norm2);
+    for (double& m : model) m *= inv;
+    const Eigen::Vector3d x = V.row(v), n = N.row(v);
+    for (int s = 0; s < ns; ++s) samples[s] = image.value(x + ((s - nc - sub * half) * h) * n);
+    int best = nc;
+    for (int c = 0; c <= 2 * nc; ++c) {
+      double sum = 0, sum2 = 0, dot = 0;
+      for (int k = 0; k < K; ++k) {
+        const double y = samples[c + sub * k];
+        sum += y;
+        sum2 += y * y;
+        dot += y * model[k];  // model is centred, so the mean of y drops out
+      }
+      const double var = sum2 - sum * sum / K;
+      const double ncc = var > 1e-12 ? dot / std::sqrt(var) : 0.0;
+      const double t = (c - nc) * h;
+      const double rel = options.range_mm > 0 ? t / options.range_mm : 0.0;
+      cost[c] = (1.0 - ncc) + options.distance_penalty * rel * rel;
+      if (cost[c] < cost[best]) best = c;
+    }
+    r.offsets[v] = cost[best] <= options.max_cost ? (best - nc) * h + refine(cost, best, h) : 0.0;
+    r.costs[v] = cost[best];
+  }
+  return r;
+}
+
+RegionStats estimate_region_stats(const VolumeSampler& image, const RowMatrixX3d& V, const RowMatrixX3d& N,
+                                  double depth_mm, double step_mm) {
+  std::vector<float> in, out;
+  const int steps = std::max(1, static_cast<int>(std::floor(depth_mm / step_mm)));
+  in.reserve(static_cast<std::size_t>(V.rows()) * steps);
+  out.reserve(static_cast<std::size_t>(V.rows()) * steps);
+  for (int v = 0; v < V.rows(); ++v) {
+    const Eigen::Vector3d x = V.row(v), n = N.row(v);
+    for (int s = 1; s <= steps; ++s) {
+      in.push_back(image.value(x - (s * step_mm) * n));
+      out.push_back(image.value(x + (s * step_mm) * n));
+    }
+  }
+  const auto median = [](std::vector<float>& a) {
+    if (a.empty()) return 0.0;
+    std::nth_element(a.begin(), a.begin() + static_cast<long>(a.size() / 2), a.end());
+    return static_cast<double>(a[a.size() / 2]);
+  };
+  RegionStats s;
+  s.inside = median(in);
+  s.outside = median(out);
+  return s;
+}
+
+}  // namespace mrsnake

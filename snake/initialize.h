@@ -1,0 +1,90 @@
+#pragma once
+/// \file initialize.h
+/// Initial pose of the model in a new volume: a similarity from the moments of a rough
+/// threshold, then (optionally) a fit of the whole coarse mesh to its own search targets,
+/// which does most of the work on real images.
+#include <limits>
+
+#include "mesh/trimesh.h"
+#include "mesh/volume.h"
+#include "snake/deformable_surface.h"
+
+namespace mrsnake {
+
+/// x ↦ scale·rotation·x + translation.
+struct Similarity {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  double scale = 1.0;
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+
+  Eigen::Vector3d apply(const Eigen::Vector3d& x) const { return scale * (rotation * x) + translation; }
+  RowMatrixX3d apply(const RowMatrixX3d& V) const;
+  /// (this ∘ other)(x) = this(other(x)).
+  Similarity compose(const Similarity& other) const;
+  double rotation_angle_deg() const;
+};
+
+/// Volume, centroid and covariance (second central moments) of a set of voxels in physical space.
+struct Moments {
+  double volume = 0;  ///< mm³
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+};
+
+/// Moments of the voxels where mask > 0.5.
+Moments mask_moments(const Volume& mask);
+
+/// Otsu's threshold of the voxels of `image` within the axis-aligned index box [lo, hi].
+double otsu_threshold(const Volume& image, const std::array<long, 3>& lo, const std::array<long, 3>& hi);
+
+/// The index box of `image` covering the mesh's bounding box grown by `margin` (a fraction
+/// of its size) on each side, clamped to the image.
+void mesh_index_box(const Volume& image, const RowMatrixX3d& V, double margin, std::array<long, 3>& lo,
+                    std::array<long, 3>& hi);
+
+/// Two-class statistics near a surface: Otsu's threshold on `smooth` (a coarser, less
+/// noisy version of `image`, e.g. a pyramid level) within the box of `image` indices [lo, hi],
+/// then the medians of `image`'s voxels in the box whose smooth value is above and below it.
+/// The smoothing keeps Otsu from splitting the noise of a large background when the object
+/// is small. What the edge force needs on a clean-contrast image, whatever the pose.
+struct ThresholdClasses {
+  double threshold = 0;
+  double upper_median = 0, lower_median = 0;
+};
+ThresholdClasses threshold_classes(const Volume& image, const Volume& smooth, const std::array<long, 3>& lo,
+                                   const std::array<long, 3>& hi);
+
+struct MomentsOptions {
+  double roi_margin = 0.3;  ///< the region of interest: the model's box grown by this fraction per side
+  bool rotate = true;       ///< also align principal axes (when they are well separated)
+  double min_axis_separation = 0.15;  ///< relative eigenvalue gap below which axes are ambiguous
+  double max_rotation_deg = 60;       ///< larger principal-axis rotations are rejected
+  /// Threshold between object and background; NaN: Otsu's within the region of interest.
+  double threshold = std::numeric_limits<double>::quiet_NaN();
+  bool bright_object = true;  ///< the object is above the threshold
+};
+
+/// The similarity mapping the model (closed mesh in its physical pose) onto the moments of
+/// the thresholded image near it: translation to the centroid, scale from the volume ratio
+/// (cube root) and, if the principal axes are distinct enough in both, the rotation (the
+/// sign choice closest to the identity) between them.
+/// \pre model is closed and outward oriented; image is small enough to threshold (use a
+///      coarse pyramid level).
+/// \throw AlgorithmError if no voxel passes the threshold near the model.
+Similarity moments_alignment(const Volume& image, const TriMesh& model, const MomentsOptions& options = {});
+
+struct TargetFitOptions {
+  int iterations = 30;
+  bool with_scale = true;   ///< similarity (true) or rigid (false)
+  double tolerance_mm = 0.01;  ///< stop when the mean vertex motion of an iteration is below this
+  double trim_fraction = 0.2;  ///< drop the worst-matching fraction of vertices each iteration
+};
+
+/// Fits a similarity of the whole mesh to its search targets x + o·n, repeatedly (a rigid
+/// or similarity "active shape" step): each iteration searches, solves the Umeyama
+/// least-squares similarity from the current vertices to their targets (trimmed), and applies it.
+/// Returns the total similarity; V is updated.
+Similarity fit_similarity_to_targets(RowMatrixX3d& V, const RowMatrixX3i& F, const ExternalSearch& search,
+                                     const TargetFitOptions& options = {}, int* iterations_done = nullptr);
+
+}  // namespace mrsnake

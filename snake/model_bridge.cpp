@@ -1,0 +1,48 @@
+#include "snake/model_bridge.h"
+
+#include <memory>
+
+#include "mesh/errors.h"
+#include "snake/image_pyramid.h"
+#include "wavelets/lifting.h"
+
+namespace mrsnake {
+
+namespace {
+std::vector<RowMatrixX3d> model_levels(const ShapeModel& model) {
+  if (static_cast<int>(model.level_positions.size()) == model.levels() + 1) return model.level_positions;
+  std::vector<RowMatrixX3d> levels;
+  for (int j = 0; j <= model.levels(); ++j) levels.push_back(synthesize(model, j));
+  return levels;
+}
+}  // namespace
+
+SnakeModel snake_model_from(const ShapeModel& model) {
+  if (model.base.rows() == 0) throw InputError("the model has no base mesh; rebuild it with mrsnake build-model");
+  SnakeModel m;
+  m.connectivity = model.connectivity();
+  m.levels = model_levels(model);
+  if (model.levels() > 0) {
+    auto transform = std::make_shared<WaveletTransform>(m.connectivity, model.wavelet);
+    auto details = std::make_shared<std::vector<RowMatrixX3d>>(model.details);
+    m.synthesize = [transform, details](int j, const RowMatrixX3d& coarse) {
+      return transform->synthesize_level(j, coarse, (*details)[j]);
+    };
+  } else {
+    m.synthesize = [](int, const RowMatrixX3d& coarse) { return coarse; };
+  }
+  if (const auto it = model.sections.find(kAppearanceSection); it != model.sections.end())
+    m.appearance = deserialize_appearance(it->second);
+  return m;
+}
+
+void add_appearance(ShapeModel& model, const Volume& reference_image, const AppearanceOptions& options) {
+  Volume normalized = reference_image;
+  normalize_intensities(normalized);
+  const std::vector<RowMatrixX3d> levels = model_levels(model);
+  const SubdivisionConnectivity conn = model.connectivity();
+  const Appearance a = build_appearance(build_pyramid(normalized, 8), levels, conn.faces, options);
+  model.sections[kAppearanceSection] = serialize_appearance(a);
+}
+
+}  // namespace mrsnake

@@ -1,0 +1,365 @@
+#include "snake/segment.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "mesh/distance.h"
+#include "mesh/errors.h"
+#include "snake/image_pyramid.h"
+#include "snake/sampler.h"
+
+namespace mrsnake {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double max_spacing(const Volume& v) { return std::max({v.spacing[0], v.spacing[1], v.spacing[2]}); }
+
+// Frame of the parent edge (a, b) from the coarse positions and vertex normals.
+Eigen::Matrix3d edge_frame(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& na,
+                           const Eigen::Vector3d& nb) {
+  Eigen::Vector3d t = b - a;
+  t.normalize();
+  Eigen::Vector3d n = na + nb;
+  n -= n.dot(t) * t;
+  if (n.norm() < 1e-12) n = t.unitOrthogonal();
+  n.normalize();
+  Eigen::Matrix3d R;
+  R.col(0) = t;
+  R.col(1) = n.cross(t);
+  R.col(2) = n;
+  return R;
+}
+}  // namespace
+
+SnakeModel midpoint_frame_model(const SubdivisionConnectivity& conn, const RowMatrixX3d& finest) {
+  SnakeModel m;
+  m.connectivity = conn;
+  const int L = conn.levels();
+  for (int j = 0; j <= L; ++j) m.levels.push_back(finest.topRows(conn.vertex_count(j)));
+  // Details of level j+1 in the frames of level j.
+  auto details = std::make_shared<std::vector<RowMatrixX3d>>();
+  RowMatrixX3d N;
+  for (int j = 0; j < L; ++j) {
+    const RowMatrixX3d& C = m.levels[j];
+    vertex_normals(C, conn.faces[j], N);
+    const int n0 = conn.vertex_count(j), n1 = conn.vertex_count(j + 1);
+    RowMatrixX3d D(n1 - n0, 3);
+    for (int v = n0; v < n1; ++v) {
+      const Eigen::Vector2i p = conn.parents(v);
+      const Eigen::Vector3d a = C.row(p[0]), b = C.row(p[1]);
+      const Eigen::Matrix3d R = edge_frame(a, b, N.row(p[0]), N.row(p[1]));
+      const double len = std::max(1e-12, (b - a).norm());
+      D.row(v - n0) = (R.transpose() * (finest.row(v).transpose() - 0.5 * (a + b)) / len).transpose();
+    }
+    details->push_back(std::move(D));
+  }
+  auto connectivity = std::make_shared<SubdivisionConnectivity>(conn);
+  m.synthesize = [details, connectivity](int j, const RowMatrixX3d& C) {
+    const SubdivisionConnectivity& cn = *connectivity;
+    RowMatrixX3d Nc;
+    vertex_normals(C, cn.faces[j], Nc);
+    const int n0 = cn.vertex_count(j), n1 = cn.vertex_count(j + 1);
+    RowMatrixX3d F(n1, 3);
+    F.topRows(n0) = C;
+    const RowMatrixX3d& D = (*details)[j];
+    for (int v = n0; v < n1; ++v) {
+      const Eigen::Vector2i p = cn.parents(v);
+      const Eigen::Vector3d a = C.row(p[0]), b = C.row(p[1]);
+      const Eigen::Matrix3d R = edge_frame(a, b, Nc.row(p[0]), Nc.row(p[1]));
+      F.row(v) = (0.5 * (a + b) + (b - a).norm() * (R * D.row(v - n0).transpose())).transpose();
+    }
+    return F;
+  };
+  return m;
+}
+
+InitMode parse_init_mode(const std::string& name) {
+  if (name == "pose") return InitMode::pose;
+  if (name == "moments") return InitMode::moments;
+  if (name == "moments+fit") return InitMode::moments_and_fit;
+  if (name == "fit") return InitMode::fit;
+  throw InputError("unknown initialization '" + name + "'; use pose, moments, moments+fit or fit");
+}
+
+std::string to_string(InitMode mode) {
+  switch (mode) {
+    case InitMode::pose: return "pose";
+    case InitMode::moments: return "moments";
+    case InitMode::moments_and_fit: return "moments+fit";
+    case InitMode::fit: return "fit";
+  }
+  return "?";
+}
+
+ForceMode parse_force_mode(const std::string& name) {
+  if (name == "auto") return ForceMode::automatic;
+  if (name == "profile") return ForceMode::profile;
+  if (name == "edge") return ForceMode::step_edge;
+  throw InputError("unknown force '" + name + "'; use auto, profile or edge");
+}
+
+std::string to_string(ForceMode mode) {
+  switch (mode) {
+    case ForceMode::automatic: return "auto";
+    case ForceMode::profile: return "profile";
+    case ForceMode::step_edge: return "edge";
+  }
+  return "?";
+}
+
+SegmentResult segment(const Volume& image, const SnakeModel& model, const SegmentOptions& options,
+                      const ProgressFn& progress) {
+  const auto t_start = Clock::now();
+  const int L = model.finest_level();
+  if (L < 0 || static_cast<int>(model.levels.size()) != L + 1 || !model.synthesize)
+    throw InputError("the model has no usable levels; rebuild it with mrsnake build-model");
+  const bool use_profiles = options.force == ForceMode::profile ||
+                            (options.force == ForceMode::automatic && model.appearance.has_value());
+  if (use_profiles) {
+    if (!model.appearance)
+      throw InputError("--force profile needs a model built with an appearance (build-model --image)");
+    if (static_cast<int>(model.appearance->levels.size()) != L + 1)
+      throw InputError("the model's appearance does not match its levels; rebuild the model");
+    for (int j = 0; j <= L; ++j)
+      if (model.appearance->levels[j].profiles.rows() != model.levels[j].rows())
+        throw InputError("the model's appearance does not match its levels; rebuild the model");
+  }
+  SegmentResult result;
+  result.force = use_profiles ? "profile" : "step_edge";
+  auto stage_timer = Clock::now();
+  const auto end_stage = [&](const std::string& name) {
+    result.stage_seconds.emplace_back(name, seconds_since(stage_timer));
+    stage_timer = Clock::now();
+  };
+
+  // Image side: robust normalization and the pyramid.
+  report(progress, "normalize", 0.0);
+  // The full-resolution image is not copied: its sampler normalizes on the fly, and only
+  // the (8× smaller and below) pyramid levels are stored normalized.
+  result.window = robust_intensity_window(image);
+  const double norm_scale = 1.0 / (result.window.high - result.window.low);
+  const double norm_offset = -result.window.low * norm_scale;
+  end_stage("normalize");
+  report(progress, "pyramid", 0.0);
+  std::vector<Volume> owned;  // levels 1.. (level 0 too when the image is too small for a pyramid)
+  owned.reserve(8);
+  std::vector<const Volume*> pyramid{&image};
+  while (pyramid.size() < 8) {
+    bool ok = true;
+    for (int a = 0; a < 3; ++a)
+      if (pyramid.back()->size[a] > 1 && (pyramid.back()->size[a] + 1) / 2 < 16) ok = false;
+    if (!ok) break;
+    owned.push_back(downsample_by_two(*pyramid.back()));
+    if (pyramid.size() == 1) apply_intensity_window(owned.back(), result.window);
+    pyramid.push_back(&owned.back());
+  }
+  if (pyramid.size() == 1) {  // a tiny image: normalize a copy
+    owned.push_back(image);
+    apply_intensity_window(owned.back(), result.window);
+    pyramid[0] = &owned.back();
+  }
+  const bool level0_raw = pyramid[0] == &image;
+  std::vector<double> spacings;
+  for (const Volume* v : pyramid) spacings.push_back(max_spacing(*v));
+  std::vector<VolumeSampler> samplers;
+  samplers.reserve(pyramid.size());
+  for (std::size_t k = 0; k < pyramid.size(); ++k)
+    samplers.emplace_back(*pyramid[k], k == 0 && level0_raw ? norm_scale : 1.0, k == 0 && level0_raw ? norm_offset : 0.0);
+  end_stage("pyramid");
+
+  // Which pyramid level each mesh level runs on, and its search.
+  std::vector<int> pyr(L + 1);
+  std::vector<double> edges(L + 1);
+  for (int j = 0; j <= L; ++j) {
+    edges[j] = mean_edge_length(model.levels[j], model.faces(j));
+    pyr[j] = pyramid_level_for_edge(edges[j], spacings, options.edge_per_voxel);
+  }
+  const auto search_for = [&](int j, double range_mm, RegionStats stats) -> std::pair<ExternalSearch, double> {
+    const int p = pyr[j];
+    const VolumeSampler* sampler = &samplers[p];
+    NormalSearchOptions so;
+    so.range_mm = range_mm;
+    if (use_profiles) {
+      const LevelAppearance* la = &model.appearance->levels[j];
+      so.step_mm = la->spacing_mm;
+      so.max_cost = options.max_profile_cost;
+      return {[sampler, la, so](const RowMatrixX3d& V, const RowMatrixX3d& N) {
+                return search_profiles(*sampler, V, N, la->profiles, la->spacing_mm, so);
+              },
+              so.step_mm};
+    }
+    so.step_mm = options.step_voxels * spacings[p];
+    so.window_mm = options.window_voxels * spacings[p];
+    so.max_cost = options.max_edge_cost;
+    return {[sampler, stats, so](const RowMatrixX3d& V, const RowMatrixX3d& N) {
+              return search_step_edges(*sampler, V, N, stats, so);
+            },
+            so.step_mm};
+  };
+  const auto range_for = [&](int j, double fraction) {
+    return std::max(options.min_range_voxels * spacings[pyr[j]], fraction * edges[j]);
+  };
+
+  // Initialization of the coarse mesh.
+  report(progress, "initialize", 0.0);
+  RowMatrixX3d V = model.levels[0];
+  Similarity pose;
+  if (options.init == InitMode::moments || options.init == InitMode::moments_and_fit) {
+    // Moments on a coarse level (noise averaged out), of a mid-resolution model level.
+    const int p = std::min<int>(2, static_cast<int>(pyramid.size()) - 1);
+    const int jm = std::min(L, 2);
+    MomentsOptions mo = options.moments;
+    if (model.appearance && std::isnan(mo.threshold)) {
+      // Towards the inside class: a neighbour of intermediate intensity stays out.
+      mo.threshold = model.appearance->region.outside +
+                     0.7 * (model.appearance->region.inside - model.appearance->region.outside);
+      mo.bright_object = model.appearance->region.inside > model.appearance->region.outside;
+    }
+    pose = moments_alignment(*pyramid[p], TriMesh{model.levels[jm], model.faces(jm)}, mo);
+    V = pose.apply(V);
+  }
+  // Start hypotheses for the fit: the pose found, and the same without its rotation about
+  // the centroid (principal axes can mislead on elongated or curved shapes).
+  std::vector<Similarity> starts{pose};
+  if (pose.rotation_angle_deg() > 1.0) {
+    const Eigen::Vector3d c = model.levels[0].colwise().mean().transpose();
+    Similarity unrotated = pose;
+    unrotated.rotation.setIdentity();
+    unrotated.translation = pose.apply(c) - pose.scale * c;
+    starts.push_back(unrotated);
+  }
+  RegionStats stats;
+  RowMatrixX3d N;
+  const auto estimate_stats = [&](const RowMatrixX3d& W) {
+    // Two classes near the surface, at full resolution: independent of how well the
+    // surface is placed, so a poor start cannot teach the force the wrong contrast.
+    std::array<long, 3> lo{}, hi{};
+    mesh_index_box(*pyramid[0], W, 0.15, lo, hi);
+    ThresholdClasses c = threshold_classes(*pyramid[0], *pyramid[std::min<std::size_t>(1, pyramid.size() - 1)], lo, hi);
+    if (level0_raw) {  // the medians come from the raw full-resolution image
+      c.upper_median = norm_scale * c.upper_median + norm_offset;
+      c.lower_median = norm_scale * c.lower_median + norm_offset;
+    }
+    const bool bright = !model.appearance || model.appearance->region.inside >= model.appearance->region.outside;
+    return bright ? RegionStats{c.upper_median, c.lower_median} : RegionStats{c.lower_median, c.upper_median};
+  };
+  if (use_profiles) {
+    stats = model.appearance->region;
+  } else {
+    stats = estimate_stats(V);
+  }
+  if (options.init == InitMode::moments_and_fit || options.init == InitMode::fit) {
+    // Fit the whole mesh of a level with enough vertices to carry the shape; synthesis
+    // follows a similarity, so the pose found there applies to S_0 as well.
+    const int jf = std::min(L, options.fit_level);
+    const auto [search, step] = search_for(jf, range_for(jf, options.coarse_range_edge_fraction), stats);
+    (void)step;
+    double best_cost = std::numeric_limits<double>::infinity();
+    for (const Similarity& start : starts) {
+      RowMatrixX3d W = start.apply(model.levels[jf]);
+      int iterations = 0;
+      const Similarity fitted = fit_similarity_to_targets(W, model.faces(jf), search, options.fit, &iterations);
+      vertex_normals(W, model.faces(jf), N);
+      const double cost = search(W, N).costs.mean();
+      if (cost < best_cost) {
+        best_cost = cost;
+        pose = fitted.compose(start);
+        result.fit_iterations = iterations;
+      }
+    }
+    V = pose.apply(model.levels[0]);
+    if (!use_profiles) stats = estimate_stats(pose.apply(model.levels[L]));
+  }
+  if (!use_profiles && !(std::abs(stats.inside - stats.outside) > 1e-6))
+    throw AlgorithmError("no contrast between the inside and the outside of the initial surface; check the pose");
+  result.initial_pose = pose;
+  result.region = stats;
+  end_stage("initialize");
+
+  // Coarse to fine.
+  const auto t_levels = Clock::now();
+  for (int j = 0; j <= L; ++j) {
+    const auto t_level = Clock::now();
+    report(progress, "level " + std::to_string(j), static_cast<double>(j) / (L + 1));
+    double synthesis_seconds = 0;
+    if (j > 0) {
+      const auto t_syn = Clock::now();
+      V = model.synthesize(j - 1, V);
+      synthesis_seconds = seconds_since(t_syn);
+    }
+    const double range = range_for(j, options.range_edge_fraction);
+    const auto [search, step] = search_for(j, range, stats);
+    const DeformableSurface snake(model.faces(j), model.levels[j], options.snake);
+    LevelOutcome out;
+    out.level = j;
+    out.pyramid_level = pyr[j];
+    out.voxel_mm = spacings[pyr[j]];
+    out.range_mm = range;
+    out.vertices = static_cast<int>(V.rows());
+    out.synthesis_seconds = synthesis_seconds;
+    out.snake = snake.run(V, search, step, range);
+    out.seconds = seconds_since(t_level);
+    out.surface = TriMesh{V, model.faces(j)};
+    result.levels.push_back(std::move(out));
+  }
+  result.stage_seconds.emplace_back("levels", seconds_since(t_levels));
+  stage_timer = Clock::now();
+  result.surface = TriMesh{V, model.faces(L)};
+  result.compute_seconds = seconds_since(t_start);
+  report(progress, "levels", 1.0);
+  if (options.count_self_intersections) {
+    report(progress, "self-intersections", 0.0);
+    result.self_intersections = count_self_intersections(result.surface);
+    end_stage("self_intersections");
+  }
+  return result;
+}
+
+nlohmann::json segment_report(const SegmentResult& r) {
+  nlohmann::json j;
+  j["force"] = r.force;
+  j["compute_seconds"] = r.compute_seconds;
+  nlohmann::json stages = nlohmann::json::object();
+  for (const auto& [name, s] : r.stage_seconds) stages[name] = s;
+  j["stage_seconds"] = stages;
+  j["intensity_window"] = {{"low", r.window.low}, {"high", r.window.high}};
+  j["region"] = {{"inside", r.region.inside}, {"outside", r.region.outside}};
+  const Eigen::AngleAxisd aa(r.initial_pose.rotation);
+  j["initial_pose"] = {{"scale", r.initial_pose.scale},
+                       {"rotation_deg", aa.angle() * 180.0 / M_PI},
+                       {"translation_mm", {r.initial_pose.translation.x(), r.initial_pose.translation.y(),
+                                           r.initial_pose.translation.z()}},
+                       {"fit_iterations", r.fit_iterations}};
+  nlohmann::json levels = nlohmann::json::array();
+  bool all_converged = true;
+  for (const LevelOutcome& l : r.levels) {
+    all_converged = all_converged && l.snake.converged;
+    levels.push_back({{"level", l.level},
+                      {"vertices", l.vertices},
+                      {"pyramid_level", l.pyramid_level},
+                      {"voxel_mm", l.voxel_mm},
+                      {"search_range_mm", l.range_mm},
+                      {"iterations", l.snake.iterations},
+                      {"converged", l.snake.converged},
+                      {"seconds", l.seconds},
+                      {"synthesis_seconds", l.synthesis_seconds},
+                      {"energy", l.snake.energy},
+                      {"external_energy", l.snake.external_energy},
+                      {"internal_energy", l.snake.internal_energy},
+                      {"mean_abs_offset_mm", l.snake.mean_abs_offset_mm},
+                      {"rejected_steps", l.snake.rejected_steps},
+                      {"flipped_faces", l.snake.flipped_faces}});
+  }
+  j["levels"] = levels;
+  j["converged"] = all_converged;
+  j["final_energy"] = r.levels.empty() ? 0.0 : r.levels.back().snake.energy;
+  j["self_intersections"] = r.self_intersections;
+  j["vertices"] = r.surface.num_vertices();
+  j["faces"] = r.surface.num_faces();
+  return j;
+}
+
+}  // namespace mrsnake

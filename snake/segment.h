@@ -1,0 +1,115 @@
+#pragma once
+/// \file segment.h
+/// The coarse-to-fine segmentation: normalize the image and build its pyramid, place the
+/// coarse mesh (model pose, moments of a rough threshold, fit to the search targets), then
+/// for each level j deform S_j on the matching pyramid level and synthesize S_{j+1} from the
+/// deformed S_j with the model's details. The connectivity never changes.
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "mesh/progress.h"
+#include "mesh/subdivision.h"
+#include "mesh/trimesh.h"
+#include "mesh/volume.h"
+#include "snake/appearance.h"
+#include "snake/deformable_surface.h"
+#include "snake/image_pyramid.h"
+#include "snake/initialize.h"
+
+namespace mrsnake {
+
+/// What the segmentation needs from a shape model.
+struct SnakeModel {
+  SubdivisionConnectivity connectivity;
+  std::vector<RowMatrixX3d> levels;  ///< S_0..S_L in the model's physical pose
+  /// S_{j+1} from a (deformed) S_j, j = 0..L−1, with the model's stored details.
+  std::function<RowMatrixX3d(int j, const RowMatrixX3d& coarse)> synthesize;
+  std::optional<Appearance> appearance;
+
+  int finest_level() const { return connectivity.levels(); }
+  const RowMatrixX3i& faces(int j) const { return connectivity.faces[j]; }
+};
+
+/// A stand-in model without lifting: S_j is the prefix of the finest level, the details are
+/// the offsets of each new vertex from its parent edge's midpoint in the edge's local frame
+/// (edge direction, mean normal of its endpoints, their cross product; scaled by the edge
+/// length), so that synthesis follows a similarity of S_j. Used for tests and when no
+/// wavelet model is at hand.
+/// \pre finest has conn.vertex_counts.back() rows.
+SnakeModel midpoint_frame_model(const SubdivisionConnectivity& conn, const RowMatrixX3d& finest);
+
+enum class InitMode {
+  pose,             ///< the model's physical pose as is
+  moments,          ///< + moments of a rough threshold
+  moments_and_fit,  ///< + a similarity fit of the coarse mesh to its search targets (default)
+  fit,              ///< the model's pose + the fit
+};
+/// \throw InputError for an unknown name (pose, moments, moments+fit, fit).
+InitMode parse_init_mode(const std::string& name);
+std::string to_string(InitMode mode);
+
+enum class ForceMode { automatic, profile, step_edge };
+/// \throw InputError for an unknown name (auto, profile, edge).
+ForceMode parse_force_mode(const std::string& name);
+std::string to_string(ForceMode mode);
+
+struct SegmentOptions {
+  SnakeOptions snake;
+  InitMode init = InitMode::moments_and_fit;
+  ForceMode force = ForceMode::automatic;  ///< automatic: profile when the model has an appearance
+  TargetFitOptions fit;
+  int fit_level = 2;  ///< the mesh level whose vertices the similarity fit uses (capped at L)
+  MomentsOptions moments;
+  /// Search range at level j: max(min_range_voxels·voxel, range_edge_fraction·edge_j); the
+  /// coarsest level uses coarse_range_edge_fraction for the initial fit.
+  double range_edge_fraction = 0.5;
+  double coarse_range_edge_fraction = 0.75;
+  double min_range_voxels = 4.0;
+  double step_voxels = 0.5;       ///< search step, in voxels of the pyramid level
+  double window_voxels = 2.0;     ///< step_edge half window, in voxels of the pyramid level
+  double edge_per_voxel = 2.0;    ///< pyramid level choice (appearance.h)
+  double max_edge_cost = 0.35;    ///< step-edge matches worse than this are ignored (forces.h)
+  double max_profile_cost = 0.9;  ///< profile matches with a correlation below 0.1 are ignored
+  bool count_self_intersections = true;
+};
+
+struct LevelOutcome {
+  int level = 0;
+  int pyramid_level = 0;
+  double voxel_mm = 0;
+  double range_mm = 0;
+  int vertices = 0;
+  SnakeLevelReport snake;
+  double seconds = 0;          ///< synthesis + snake of this level
+  double synthesis_seconds = 0;
+  TriMesh surface;             ///< S_j after deformation
+};
+
+struct SegmentResult {
+  TriMesh surface;             ///< the final level
+  std::vector<LevelOutcome> levels;
+  Similarity initial_pose;     ///< applied to the model's S_0 before the coarse-to-fine run
+  int fit_iterations = 0;
+  RegionStats region;
+  IntensityWindow window;
+  int self_intersections = -1; ///< -1 when not counted
+  std::string force;           ///< "profile" or "step_edge"
+  std::vector<std::pair<std::string, double>> stage_seconds;
+  double compute_seconds = 0;  ///< everything after loading, without the self-intersection count
+};
+
+/// Segments `image` (any spacing and direction; not modified) with the model.
+/// \throw InputError if the model has no levels or its appearance does not match it.
+/// \throw AlgorithmError if the initialization finds nothing to align to.
+SegmentResult segment(const Volume& image, const SnakeModel& model, const SegmentOptions& options = {},
+                      const ProgressFn& progress = {});
+
+/// The report of `mrsnake segment` (timings per stage and level, iterations, convergence,
+/// final energy, self-intersection count).
+nlohmann::json segment_report(const SegmentResult& result);
+
+}  // namespace mrsnake

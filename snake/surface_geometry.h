@@ -1,0 +1,40 @@
+#pragma once
+/// \file surface_geometry.h
+/// Per-vertex geometry on a fixed connectivity: 1-rings built once per level (CSR), face
+/// and vertex normals, umbrella vectors and local edge lengths. Plain loops, no allocation
+/// in the per-iteration calls.
+#include <vector>
+
+#include "mesh/trimesh.h"
+
+namespace mrsnake {
+
+/// The 1-ring of every vertex of a fixed connectivity, in compressed rows.
+struct VertexRings {
+  std::vector<int> offsets;    ///< ring of v: neighbors[offsets[v] .. offsets[v+1])
+  std::vector<int> neighbors;
+  int num_vertices() const { return static_cast<int>(offsets.size()) - 1; }
+  int valence(int v) const { return offsets[v + 1] - offsets[v]; }
+};
+
+/// Builds the rings of the n vertices of F (each neighbour listed once).
+/// \pre F references only vertices in [0, n).
+VertexRings build_vertex_rings(const RowMatrixX3i& F, int n);
+
+/// Unit face normals (zero for a degenerate face).
+void face_normals(const RowMatrixX3d& V, const RowMatrixX3i& F, RowMatrixX3d& N);
+
+/// Unit vertex normals: the normalized sum of the area-weighted normals of the faces around
+/// each vertex (outward for an outward-oriented mesh).
+void vertex_normals(const RowMatrixX3d& V, const RowMatrixX3i& F, RowMatrixX3d& N);
+
+/// Umbrella vectors U_v = mean of the ring − x_v.
+void umbrella(const VertexRings& rings, const RowMatrixX3d& V, RowMatrixX3d& U);
+
+/// Mean length of the edges from each vertex to its ring.
+void ring_edge_lengths(const VertexRings& rings, const RowMatrixX3d& V, Eigen::VectorXd& lengths);
+
+/// Replaces each value by the mean over the vertex and its ring, `passes` times.
+void smooth_on_rings(const VertexRings& rings, Eigen::VectorXd& values, int passes);
+
+}  // namespace mrsnake

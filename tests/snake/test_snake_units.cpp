@@ -1,0 +1,403 @@
+// Unit tests of the snake module: sampler, pyramid, rasterization, internal forces,
+// initialization, the stand-in model's synthesis, the searches and appearance I/O.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+
+#include "mesh/errors.h"
+#include "mesh/marching_cubes.h"
+#include "mesh/primitives.h"
+#include "mesh/subdivision.h"
+#include "snake/appearance.h"
+#include "snake/deformable_surface.h"
+#include "snake/forces.h"
+#include "snake/image_pyramid.h"
+#include "snake/initialize.h"
+#include "snake/rasterize.h"
+#include "snake/sampler.h"
+#include "snake/segment.h"
+#include "snake/surface_geometry.h"
+
+using namespace mrsnake;
+
+namespace {
+
+Eigen::Matrix3d rotation(double deg, Eigen::Vector3d axis) {
+  return Eigen::AngleAxisd(deg * M_PI / 180.0, axis.normalized()).toRotationMatrix();
+}
+
+Volume make_grid(std::array<std::size_t, 3> size, std::array<double, 3> spacing, std::array<double, 3> origin,
+                 const Eigen::Matrix3d& D) {
+  Volume v;
+  v.size = size;
+  v.spacing = spacing;
+  v.origin = origin;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) v.direction[3 * r + c] = D(r, c);
+  v.data.assign(v.num_voxels(), 0.0f);
+  return v;
+}
+
+Eigen::Vector3d physical(const Volume& v, std::size_t i, std::size_t j, std::size_t k) {
+  const auto p = v.index_to_physical(static_cast<double>(i), static_cast<double>(j), static_cast<double>(k));
+  return {p[0], p[1], p[2]};
+}
+
+// Fills a volume with an implicit object: value `in` where phi < 0, `out` elsewhere,
+// supersampled (n³ per voxel) for partial volume.
+template <class Phi>
+void fill_object(Volume& v, Phi phi, float in, float out, int n = 3) {
+  for (std::size_t k = 0; k < v.size[2]; ++k)
+    for (std::size_t j = 0; j < v.size[1]; ++j)
+      for (std::size_t i = 0; i < v.size[0]; ++i) {
+        int inside = 0;
+        for (int a = 0; a < n; ++a)
+          for (int b = 0; b < n; ++b)
+            for (int c = 0; c < n; ++c) {
+              const auto p = v.index_to_physical(i + (a + 0.5) / n - 0.5, j + (b + 0.5) / n - 0.5, k + (c + 0.5) / n - 0.5);
+              inside += phi(Eigen::Vector3d(p[0], p[1], p[2])) < 0;
+            }
+        const double f = inside / double(n * n * n);
+        v.at(i, j, k) = static_cast<float>(out + f * (in - out));
+      }
+}
+
+}  // namespace
+
+TEST(Sampler, ExactOnALinearImageWithObliqueDirection) {
+  const Eigen::Matrix3d D = rotation(30, {1, 2, 3});
+  Volume v = make_grid({9, 8, 7}, {0.7, 1.1, 1.9}, {3, -2, 5}, D);
+  const Eigen::Vector3d a(0.3, -1.2, 2.1);
+  const double c = 4.0;
+  for (std::size_t k = 0; k < 7; ++k)
+    for (std::size_t j = 0; j < 8; ++j)
+      for (std::size_t i = 0; i < 9; ++i) v.at(i, j, k) = static_cast<float>(a.dot(physical(v, i, j, k)) + c);
+  const VolumeSampler s(v);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> ui(0.2, 7.8), uj(0.2, 6.8), uk(0.2, 5.8);
+  for (int t = 0; t < 200; ++t) {
+    const auto p = v.index_to_physical(ui(rng), uj(rng), uk(rng));
+    const Eigen::Vector3d x(p[0], p[1], p[2]);
+    Eigen::Vector3d g;
+    const float val = s.value_and_gradient(x, g);
+    EXPECT_NEAR(val, a.dot(x) + c, 1e-3);
+    EXPECT_NEAR(s.value(x), a.dot(x) + c, 1e-3);
+    EXPECT_NEAR((g - a).norm(), 0.0, 1e-4);
+    EXPECT_TRUE(s.inside(x));
+  }
+  // Outside: the nearest border value, and inside() says so.
+  const auto far = v.index_to_physical(-5, 3, 3);
+  const auto edge = v.index_to_physical(0, 3, 3);
+  EXPECT_FALSE(s.inside({far[0], far[1], far[2]}));
+  EXPECT_NEAR(s.value({far[0], far[1], far[2]}), s.value({edge[0], edge[1], edge[2]}), 1e-4);
+}
+
+TEST(Pyramid, DownsamplingKeepsPhysicalPositions) {
+  const Eigen::Matrix3d D = rotation(20, {0, 1, 1});
+  Volume v = make_grid({16, 12, 9}, {1.0, 0.5, 2.0}, {1, 2, 3}, D);
+  const Eigen::Vector3d a(1.0, -2.0, 0.5);
+  for (std::size_t k = 0; k < v.size[2]; ++k)
+    for (std::size_t j = 0; j < v.size[1]; ++j)
+      for (std::size_t i = 0; i < v.size[0]; ++i) v.at(i, j, k) = static_cast<float>(a.dot(physical(v, i, j, k)));
+  const Volume h = downsample_by_two(v);
+  EXPECT_EQ(h.size[0], 8u);
+  EXPECT_EQ(h.size[1], 6u);
+  EXPECT_EQ(h.size[2], 5u);  // odd axis: the last block is a single slice
+  EXPECT_DOUBLE_EQ(h.spacing[1], 1.0);
+  // The mean of a linear function over a full block is its value at the block centre.
+  for (std::size_t k = 0; k < 4; ++k)
+    for (std::size_t j = 0; j < h.size[1]; ++j)
+      for (std::size_t i = 0; i < h.size[0]; ++i) EXPECT_NEAR(h.at(i, j, k), a.dot(physical(h, i, j, k)), 1e-3);
+  const auto pyr = build_pyramid(v, 5, 4);
+  EXPECT_EQ(pyr.size(), 2u);  // 9 → 5 → 3 (< 4) stops
+}
+
+TEST(Pyramid, NormalizationMapsPercentiles) {
+  Volume v = make_grid({10, 10, 10}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
+  for (std::size_t i = 0; i < v.data.size(); ++i) v.data[i] = static_cast<float>(i);  // 0..999
+  const IntensityWindow w = normalize_intensities(v, 10, 90);
+  EXPECT_NEAR(w.low, 100, 1.0);
+  EXPECT_NEAR(w.high, 899, 1.0);
+  EXPECT_NEAR(v.data[100], 0.0, 0.01);
+  EXPECT_NEAR(v.data[899], 1.0, 0.01);
+  Volume flat = make_grid({4, 4, 4}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
+  EXPECT_THROW(normalize_intensities(flat), InputError);
+}
+
+TEST(Rasterize, SphereMatchesTheLatticeWithObliqueDirection) {
+  const Eigen::Matrix3d D = rotation(35, {1, -1, 2});
+  const Volume grid = make_grid({40, 36, 30}, {0.8, 0.9, 1.1}, {-12, -14, -11}, D);
+  const Eigen::Vector3d centre = physical(grid, 20, 18, 15) + Eigen::Vector3d(0.13, -0.21, 0.17);
+  const double r = 10.0;
+  TriMesh sphere = icosphere(5, r);
+  sphere.V.rowwise() += centre.transpose();
+  // The icosphere lies between its inradius (distance to the flattest face) and r.
+  double r_in = r;
+  for (int f = 0; f < sphere.num_faces(); ++f) {
+    const Eigen::Vector3d a = sphere.V.row(sphere.F(f, 0)), b = sphere.V.row(sphere.F(f, 1)),
+                          c = sphere.V.row(sphere.F(f, 2));
+    const Eigen::Vector3d n = (b - a).cross(c - a).normalized();
+    r_in = std::min(r_in, std::abs(n.dot(a - centre)));
+  }
+  const Volume labels = rasterize_mesh(sphere, grid, 1.0f);
+  long count = 0, wrong = 0, ambiguous = 0;
+  for (std::size_t k = 0; k < grid.size[2]; ++k)
+    for (std::size_t j = 0; j < grid.size[1]; ++j)
+      for (std::size_t i = 0; i < grid.size[0]; ++i) {
+        const double d = (physical(grid, i, j, k) - centre).norm();
+        const bool in = labels.at(i, j, k) > 0.5f;
+        count += in;
+        if (d < r_in) wrong += !in;
+        else if (d > r) wrong += in;
+        else ++ambiguous;
+      }
+  EXPECT_EQ(wrong, 0);
+  EXPECT_LT(ambiguous, 40);
+  const double voxel = 0.8 * 0.9 * 1.1;
+  EXPECT_NEAR(count * voxel, 4.0 / 3.0 * M_PI * r * r * r, 0.01 * 4.0 / 3.0 * M_PI * r * r * r);
+  EXPECT_EQ(labels.direction, grid.direction);
+  EXPECT_EQ(labels.origin, grid.origin);
+}
+
+TEST(Internal, UmbrellaOfARegularPlanarPatchIsZero) {
+  // A regular triangulated plane (valence 6 inside), with an arbitrary rigid motion.
+  const int n = 7;
+  RowMatrixX3d V(n * n, 3);
+  const Eigen::Matrix3d R = rotation(40, {1, 1, 0});
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x)
+      V.row(y * n + x) = (R * Eigen::Vector3d(x + 0.5 * y, y * std::sqrt(3.0) / 2, 0) + Eigen::Vector3d(1, 2, 3)).transpose();
+  std::vector<Eigen::Vector3i> faces;
+  for (int y = 0; y + 1 < n; ++y)
+    for (int x = 0; x + 1 < n; ++x) {
+      const int a = y * n + x;
+      faces.emplace_back(a, a + 1, a + n);
+      faces.emplace_back(a + 1, a + n + 1, a + n);
+    }
+  RowMatrixX3i F(faces.size(), 3);
+  for (std::size_t f = 0; f < faces.size(); ++f) F.row(f) = faces[f].transpose();
+  const VertexRings rings = build_vertex_rings(F, n * n);
+  RowMatrixX3d U;
+  umbrella(rings, V, U);
+  for (int y = 1; y + 1 < n; ++y)
+    for (int x = 1; x + 1 < n; ++x) {
+      EXPECT_EQ(rings.valence(y * n + x), 6);
+      EXPECT_NEAR(U.row(y * n + x).norm(), 0.0, 1e-12);
+    }
+}
+
+TEST(Internal, PriorTermIsZeroAtTheModelsShapeInAnyPose) {
+  // A non-uniform model: an ellipsoid-like bumpy icosphere.
+  TriMesh m = icosphere(3, 10.0);
+  for (int v = 0; v < m.num_vertices(); ++v) {
+    Eigen::Vector3d x = m.V.row(v);
+    x = x.cwiseProduct(Eigen::Vector3d(1.4, 1.0, 0.7)) * (1.0 + 0.1 * std::sin(x.x() / 3));
+    m.V.row(v) = x.transpose();
+  }
+  SnakeOptions o;
+  o.tangential_weight = 0;  // the tangential term regularizes sampling, not shape
+  o.membrane_weight = 0;
+  o.prior_weight = 0.5;
+  o.thin_plate_weight = 0.2;
+  const DeformableSurface snake(m.F, m.V, o);
+  EXPECT_LT(snake.internal_forces(m.V).rowwise().norm().maxCoeff(), 1e-10);
+  Similarity s;
+  s.rotation = rotation(50, {1, 2, -1});
+  s.scale = 1.7;
+  s.translation = {5, -3, 2};
+  const RowMatrixX3d moved = s.apply(m.V);
+  EXPECT_LT(snake.internal_forces(moved).rowwise().norm().maxCoeff(), 1e-9);
+  // A plain membrane is not zero there (it shrinks the surface), and the prior pulls back a bump.
+  SnakeOptions plain = o;
+  plain.prior_weight = 0;
+  plain.thin_plate_weight = 0;
+  plain.membrane_weight = 0.5;
+  const DeformableSurface membrane(m.F, m.V, plain);
+  EXPECT_GT(membrane.internal_forces(m.V).rowwise().norm().maxCoeff(), 1e-2);
+  RowMatrixX3d bumped = m.V;
+  RowMatrixX3d N;
+  vertex_normals(m.V, m.F, N);
+  bumped.row(100) += 2.0 * N.row(100);
+  EXPECT_LT(snake.internal_forces(bumped).row(100).dot(N.row(100)), -0.1);
+}
+
+TEST(Model, MidpointFrameSynthesisFollowsASimilarity) {
+  const TriMesh base = icosahedron(10.0);
+  const SubdivisionConnectivity conn = subdivide_connectivity(base.F, base.num_vertices(), 3);
+  RowMatrixX3d finest = icosphere(3, 10.0).V;
+  for (int v = 0; v < finest.rows(); ++v) finest.row(v) *= 1.0 + 0.05 * std::cos(finest(v, 0));
+  const SnakeModel model = midpoint_frame_model(conn, finest);
+  for (int j = 0; j < 3; ++j) {
+    EXPECT_LT((model.synthesize(j, model.levels[j]) - model.levels[j + 1]).cwiseAbs().maxCoeff(), 1e-10);
+    Similarity s;
+    s.rotation = rotation(70, {0, 1, 1});
+    s.scale = 0.6;
+    s.translation = {1, 2, 3};
+    EXPECT_LT((model.synthesize(j, s.apply(model.levels[j])) - s.apply(model.levels[j + 1])).cwiseAbs().maxCoeff(), 1e-9);
+  }
+}
+
+TEST(Initialize, MomentsRecoverAKnownSimilarity) {
+  // Model: an ellipsoid with distinct axes. Image: the same ellipsoid under a known similarity.
+  const Eigen::Vector3d axes(12, 8, 5);
+  TriMesh model = icosphere(4, 1.0);
+  for (int v = 0; v < model.num_vertices(); ++v) model.V.row(v) = model.V.row(v).cwiseProduct(axes.transpose());
+  model.V.rowwise() += Eigen::Vector3d(32, 32, 32).transpose();
+  Similarity truth;
+  truth.rotation = rotation(12, {1, 2, 0.5});
+  truth.scale = 1.08;
+  truth.translation = Eigen::Vector3d(32, 32, 32) + Eigen::Vector3d(2.5, -1.5, 3.0) -
+                      truth.scale * (truth.rotation * Eigen::Vector3d(32, 32, 32));
+  Volume image = make_grid({64, 64, 64}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
+  const Eigen::Matrix3d inv = truth.rotation.transpose() / truth.scale;
+  fill_object(
+      image,
+      [&](const Eigen::Vector3d& p) {
+        const Eigen::Vector3d q = inv * (p - truth.translation) - Eigen::Vector3d(32, 32, 32);
+        return q.cwiseQuotient(axes).squaredNorm() - 1.0;
+      },
+      1.0f, 0.0f, 2);
+  const Similarity s = moments_alignment(image, model);
+  EXPECT_NEAR(s.scale, truth.scale, 0.02);
+  EXPECT_LT(Eigen::AngleAxisd(s.rotation * truth.rotation.transpose()).angle() * 180 / M_PI, 2.0);
+  const Eigen::Vector3d c(32, 32, 32);
+  EXPECT_LT((s.apply(c) - truth.apply(c)).norm(), 0.3);
+}
+
+TEST(Initialize, TargetFitRecoversASimilarity) {
+  // The search reports the exact offset along the normal to a sphere of radius 10 at (1,2,3).
+  const Eigen::Vector3d centre(1, 2, 3);
+  const ExternalSearch search = [&](const RowMatrixX3d& V, const RowMatrixX3d& N) {
+    SearchResult r;
+    r.offsets.resize(V.rows());
+    r.costs.setZero(V.rows());
+    for (int v = 0; v < V.rows(); ++v) {
+      // Solve |x + t n − c| = 10 for the root closest to 0.
+      const Eigen::Vector3d d = V.row(v).transpose() - centre, n = N.row(v).transpose();
+      const double b = d.dot(n), cc = d.squaredNorm() - 100.0, disc = std::max(0.0, b * b - cc);
+      const double t1 = -b + std::sqrt(disc), t2 = -b - std::sqrt(disc);
+      r.offsets[v] = std::abs(t1) < std::abs(t2) ? t1 : t2;
+    }
+    return r;
+  };
+  TriMesh m = icosphere(2, 7.0);
+  RowMatrixX3d V = m.V;
+  V.rowwise() += Eigen::Vector3d(2.0, 1.0, 4.0).transpose();
+  TargetFitOptions o;
+  o.iterations = 50;
+  o.trim_fraction = 0;
+  fit_similarity_to_targets(V, m.F, search, o);
+  EXPECT_LT((V.colwise().mean() - centre.transpose()).norm(), 0.05);
+  const Eigen::VectorXd radii = (V.rowwise() - centre.transpose()).rowwise().norm();
+  EXPECT_NEAR(radii.mean(), 10.0, 0.05);
+}
+
+TEST(Forces, StepEdgeAndProfileFindAPlaneBoundary) {
+  // Bright half-space x < 10.3 (blurred by partial volume); vertices on x = 8 with normal +x.
+  Volume image = make_grid({32, 16, 16}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
+  fill_object(image, [](const Eigen::Vector3d& p) { return p.x() - 10.3; }, 1.0f, 0.0f, 5);
+  const VolumeSampler s(image);
+  RowMatrixX3d V(3, 3), N(3, 3);
+  for (int v = 0; v < 3; ++v) {
+    V.row(v) = Eigen::RowVector3d(8.0, 6.0 + v, 7.0 + 0.5 * v);
+    N.row(v) = Eigen::RowVector3d(1, 0, 0);
+  }
+  NormalSearchOptions o;
+  o.range_mm = 4;
+  o.step_mm = 0.5;
+  o.window_mm = 2;
+  const SearchResult r = search_step_edges(s, V, N, RegionStats{1.0, 0.0}, o);
+  for (int v = 0; v < 3; ++v) EXPECT_NEAR(r.offsets[v], 2.3, 0.15);
+  // Profiles learned on the true boundary find it from 2.3 mm away.
+  RowMatrixX3d on = V;
+  on.col(0).setConstant(10.3);
+  const Eigen::MatrixXf learned = sample_profiles(s, on, N, 5, 1.0);
+  const SearchResult p = search_profiles(s, V, N, learned, 1.0, o);
+  for (int v = 0; v < 3; ++v) EXPECT_NEAR(p.offsets[v], 2.3, 0.3);
+  const RegionStats st = estimate_region_stats(s, on, N, 2.0, 0.5);
+  EXPECT_NEAR(st.inside, 1.0, 0.2);
+  EXPECT_NEAR(st.outside, 0.0, 0.2);
+}
+
+TEST(Appearance, SerializationRoundTripsAndRejectsDamage) {
+  Appearance a;
+  a.half_length = 2;
+  a.region = {0.8, 0.1};
+  a.inside_spread = 0.05;
+  a.levels.resize(2);
+  a.levels[0].spacing_mm = 2;
+  a.levels[0].profiles = Eigen::MatrixXf::Random(12, 5);
+  a.levels[1].spacing_mm = 1;
+  a.levels[1].profiles = Eigen::MatrixXf::Random(42, 5);
+  const auto bytes = serialize_appearance(a);
+  const Appearance b = deserialize_appearance(bytes);
+  EXPECT_EQ(b.half_length, 2);
+  EXPECT_DOUBLE_EQ(b.region.inside, 0.8);
+  ASSERT_EQ(b.levels.size(), 2u);
+  EXPECT_EQ(b.levels[1].profiles, a.levels[1].profiles);
+  auto cut = bytes;
+  cut.resize(cut.size() - 3);
+  EXPECT_THROW(deserialize_appearance(cut), InputError);
+  auto bad = bytes;
+  bad[0] = 'X';
+  EXPECT_THROW(deserialize_appearance(bad), InputError);
+}
+
+TEST(Snake, AdversarialTargetsNeverFlipAFace) {
+  // Targets alternate ±5 mm along the normals from vertex to vertex (a worst case a noisy
+  // search can produce): the steps that would flip a face are halved or dropped.
+  const TriMesh m = icosphere(3, 10.0);
+  SnakeOptions o;
+  o.external_weight = 1.0;
+  o.offset_smoothing = 0;
+  o.max_step_fraction = 1.0;
+  o.prior_weight = 0;
+  o.tangential_weight = 0;
+  o.thin_plate_weight = 0;
+  o.max_iterations = 20;
+  const DeformableSurface snake(m.F, m.V, o);
+  const ExternalSearch search = [](const RowMatrixX3d& V, const RowMatrixX3d&) {
+    SearchResult r;
+    r.offsets.resize(V.rows());
+    r.costs.setZero(V.rows());
+    for (int v = 0; v < V.rows(); ++v) r.offsets[v] = (v % 2 ? 5.0 : -5.0);
+    return r;
+  };
+  RowMatrixX3d V = m.V;
+  const SnakeLevelReport rep = snake.run(V, search, 0.5);
+  EXPECT_GT(rep.rejected_steps, 0);
+  EXPECT_EQ(rep.flipped_faces, 0);
+  RowMatrixX3d N0, N1;
+  face_normals(m.V, m.F, N0);
+  face_normals(V, m.F, N1);
+  for (int f = 0; f < m.num_faces(); ++f) EXPECT_GT(N0.row(f).dot(N1.row(f)), 0.0) << f;
+  // The trust region holds every vertex within its radius of the start.
+  RowMatrixX3d W = m.V;
+  snake.run(W, search, 0.5, 1.5);
+  EXPECT_LE((W - m.V).rowwise().norm().maxCoeff(), 1.5 + 1e-9);
+}
+
+TEST(Snake, ConvergesOntoASphereInAVolume) {
+  Volume image = make_grid({48, 48, 48}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
+  const Eigen::Vector3d c(24.2, 23.7, 24.4);
+  fill_object(image, [&](const Eigen::Vector3d& p) { return (p - c).norm() - 14.0; }, 1.0f, 0.0f, 3);
+  TriMesh m = icosphere(3, 11.0);
+  m.V.rowwise() += c.transpose();
+  const VolumeSampler s(image);
+  NormalSearchOptions so;
+  so.range_mm = 4;
+  so.step_mm = 0.5;
+  so.window_mm = 2;
+  const ExternalSearch search = [&](const RowMatrixX3d& V, const RowMatrixX3d& N) {
+    return search_step_edges(s, V, N, RegionStats{1.0, 0.0}, so);
+  };
+  const DeformableSurface snake(m.F, m.V, SnakeOptions{});
+  RowMatrixX3d V = m.V;
+  const SnakeLevelReport rep = snake.run(V, search, so.step_mm);
+  EXPECT_TRUE(rep.converged);
+  const Eigen::VectorXd radii = (V.rowwise() - c.transpose()).rowwise().norm();
+  EXPECT_NEAR(radii.mean(), 14.0, 0.15);  // the prior is scale invariant: no shrinkage
+  EXPECT_LT(radii.maxCoeff() - radii.minCoeff(), 0.6);
+}
