@@ -22,10 +22,19 @@ std::string text(const nlohmann::json& v, int digits = 4) {
   if (v.is_number_integer()) return std::to_string(v.get<long long>());
   if (v.is_number()) {
     char buf[64];
-    std::snprintf(buf, sizeof buf, "%.*g", digits, v.get<double>());
+    const double x = v.get<double>();
+    if (std::abs(x) >= 1e4 && std::abs(x) < 1e12)
+      std::snprintf(buf, sizeof buf, "%.0f", x);  // volumes in mm³: no exponent
+    else
+      std::snprintf(buf, sizeof buf, "%.*g", digits, x);
     return buf;
   }
   if (v.is_string()) return v.get<std::string>();
+  if (v.is_array()) {
+    std::string out;
+    for (const auto& e : v) out += (out.empty() ? "" : ", ") + text(e, digits);
+    return out;
+  }
   return v.dump();
 }
 
