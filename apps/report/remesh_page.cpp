@@ -41,11 +41,17 @@ std::string setting(const nlohmann::json& v) {
 
 /// Quality and distance of one level: from its stats when remesh computed them, else
 /// computed here (distance only when the input is known).
-std::pair<nlohmann::json, nlohmann::json> level_figures(const RemeshResult& result, int j, const TriMesh* input) {
+std::pair<nlohmann::json, nlohmann::json> level_figures(const RemeshResult& result, int j, const TriMesh* input,
+                                                        int samples_per_face, bool* computed) {
   const nlohmann::json& s = result.levels[j].stats;
   nlohmann::json quality = s.contains("quality") ? s["quality"] : nlohmann::json(mesh_quality(result.mesh(j)));
   nlohmann::json distance = s.contains("distance") ? s["distance"] : nlohmann::json();
-  if (distance.is_null() && input) distance = surface_distance(result.mesh(j), *input);
+  if (distance.is_null() && input) {
+    DistanceOptions o;
+    o.samples_per_face = samples_per_face;
+    distance = surface_distance(result.mesh(j), *input, o);
+    *computed = true;
+  }
   return {quality, distance};
 }
 
@@ -151,10 +157,14 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
                               "(--compare-unrelaxed)."
                             : ""));
   std::vector<std::vector<std::string>> rows;
-  bool distance_missing = false;
+  bool distance_missing = false, distance_computed = false;
+  int samples = options.distance_samples_per_face;
+  if (samples <= 0)
+    samples = options.input ? std::clamp(static_cast<int>(500000 / std::max<Eigen::Index>(1, options.input->num_faces())), 1, 10)
+                            : 10;
   const auto add_rows = [&](const RemeshResult& res, const std::string& variant) {
     for (int j = 0; j <= L; ++j) {
-      const auto [q, d] = level_figures(res, j, options.input);
+      const auto [q, d] = level_figures(res, j, options.input, samples, &distance_computed);
       if (d.is_null()) distance_missing = true;
       rows.push_back({std::to_string(j), variant, std::to_string(res.levels[j].positions.rows()),
                       std::to_string(res.connectivity.faces[j].rows()), cell(d, "rms_pct", 3), cell(d, "hausdorff_pct", 3),
@@ -174,6 +184,10 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
     for (auto& row : rows) row.erase(row.begin() + 1);
   }
   page.table(header, rows);
+  if (distance_computed)
+    page.paragraph("Distances of this page: every vertex plus " + std::to_string(samples) +
+                   " random point(s) per face of each mesh, measured against the other (report.json has none: run "
+                   "with --full-report for remesh's own figures).");
   if (distance_missing) page.note("The geometric error needs the input surface; it was not given to this page.");
 
   // Renders of every level.
@@ -214,10 +228,16 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
   if (can_render) {
     picture(page, "The domain picture", [&] {
       const std::vector<double> stretch = face_stretch(result, L);
+      // Colours over the 1st to 99th percentile: a few faces at a pole would otherwise
+      // squeeze everything else into one colour.
+      std::vector<double> sorted = stretch;
+      std::sort(sorted.begin(), sorted.end());
+      const double p1 = sorted[sorted.size() / 100], p99 = sorted[sorted.size() - 1 - sorted.size() / 100];
       RenderOptions ro;
       ro.width = 560;
       ro.height = 460;
       ro.face_scalars = stretch;
+      for (double& v : ro.face_scalars) v = std::clamp(v, p1, p99);
       ro.log_scale = true;
       ro.scalar_title = "stretch";
       ro.wireframe = result.connectivity.faces[L].rows() <= kWireframeFaceLimit / 2;
@@ -226,7 +246,8 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
       const auto [lo, hi] = std::minmax_element(stretch.begin(), stretch.end());
       page.begin_figures();
       page.png(render_mesh_png(domain, ro), "domain of level " + std::to_string(L) + ", stretch from " + fixed(*lo, 3) +
-                                                " to " + fixed(*hi, 3));
+                                                " to " + fixed(*hi, 3) +
+                                                " (colours: 1st to 99th percentile)");
       if (result.domain == "sphere") {
         ro.azimuth += 180;  // the far side of the sphere
         page.png(render_mesh_png(domain, ro), "the far side");
