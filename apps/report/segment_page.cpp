@@ -81,7 +81,7 @@ std::string segment_report_html(const SegmentPageInput& in) {
   std::vector<LabelContour> label_contours;
   if (in.truth) label_contours.push_back({in.truth, in.truth_label, {64, 220, 64}, "truth"});
   page.paragraph(std::string("Three orthogonal slices through the centre of the final surface: the final contour in red") +
-                 (in.truth ? ", the truth's outline in green." : ". (No --truth was given.)"));
+                 (in.truth ? ", the truth's outline in green (hidden under the red where the two agree)." : ". (No --truth was given.)"));
   page.begin_figures();
   const char* axis_names[] = {"sagittal (x)", "coronal (y)", "axial (z)"};
   std::array<double, 3> centre{};
