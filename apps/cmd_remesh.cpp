@@ -20,7 +20,7 @@ void add_remesh_command(CLI::App& app) {
   struct Args {
     std::string mesh, out;
     int levels = 0, faces = 16000, base_vertices = 32, iterations = 8, shape_iterations = 3;
-    double exponent = 2.0;
+    double exponent = 2.0, curvature = 1.0;
     bool no_relax = false, strict = false, json = false, compare_unrelaxed = false;
   };
   auto args = std::make_shared<Args>();
@@ -41,6 +41,8 @@ void add_remesh_command(CLI::App& app) {
   no_relax->excludes(strict);
   cmd->add_option("--density-exponent", args->exponent, "Lloyd density = stretch^e (default 2: even 3D spacing)")
       ->check(CLI::Range(0.0, 8.0));
+  cmd->add_option("--curvature-weight", args->curvature, "Denser where the surface bends: 3D density 1 + w·κ/mean κ (default 1; 0 = even spacing)")
+      ->check(CLI::Range(0.0, 100.0));
   cmd->add_option("--iterations", args->iterations, "Lloyd iterations per level (default 8)")->check(CLI::Range(0, 1000));
   cmd->add_option("--shape-iterations", args->shape_iterations,
                   "Iterations per level of 3D shape smoothing after Lloyd (default 3; not with --strict or --no-relax)")
@@ -59,6 +61,7 @@ void add_remesh_command(CLI::App& app) {
     options.lloyd_iterations = args->iterations;
     options.density_exponent = args->exponent;
     options.shape_iterations = args->shape_iterations;
+    options.curvature_weight = args->curvature;
     options.relax = args->no_relax ? RelaxMode::none : args->strict ? RelaxMode::new_vertices_only : RelaxMode::all_vertices;
     if (!global_options().quiet) options.progress = terminal_progress();
     const RemeshResult result = remesh(input, options);
@@ -71,9 +74,10 @@ void add_remesh_command(CLI::App& app) {
       unrelaxed = remesh(input, plain);
       report["unrelaxed"] = remesh_report(*unrelaxed, plain);
     }
-    // Everything is computed before anything is written; each file is written atomically.
-    ensure_writable_directory(args->out);
-    const std::filesystem::path dir(args->out);
+    // Everything is computed before anything is written, into a temporary folder renamed
+    // into place at the end: a failure or an interrupt leaves nothing under DIR.
+    AtomicDirectory out(args->out);
+    const std::filesystem::path dir(out.temp_path());
     for (int j = 0; j <= result.connectivity.levels(); ++j)
       write_mesh((dir / ("level_" + std::to_string(j) + ".vtp")).string(), result.mesh(j));
     write_text_file_atomically((dir / "report.json").string(), report.dump(2) + "\n");
@@ -83,6 +87,7 @@ void add_remesh_command(CLI::App& app) {
     page.unrelaxed = unrelaxed ? &*unrelaxed : nullptr;
     page.report = report;
     mrsnake::reports::write_remesh_report((dir / "report.html").string(), result, page);
+    out.commit();
     if (args->json) {
       print_json(report);
       return;

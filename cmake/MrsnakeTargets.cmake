@@ -21,7 +21,7 @@ function(mrsnake_add_itk_library name)
   target_include_directories(mrsnake_${name} SYSTEM PRIVATE ${ITK_INCLUDE_DIRS})
   target_link_libraries(mrsnake_${name} PRIVATE ${ITK_LIBRARIES} PUBLIC ${ARG_DEPS})
   mrsnake_warnings(mrsnake_${name})
-  if(MRSNAKE_SANITIZE OR MRSNAKE_FUZZ)
+  if(MRSNAKE_SANITIZE)
     # ITK 5.2's neighborhood iterators offset a null pointer in their headers
     # (itkConstNeighborhoodIterator.hxx:705): an upstream defect, harmless in practice.
     target_compile_options(mrsnake_${name} PRIVATE -fno-sanitize=pointer-overflow)

@@ -3,15 +3,11 @@
 #include <vtkCellArray.h>
 #include <vtkCleanPolyData.h>
 #include <vtkNew.h>
-#include <vtkOBJReader.h>
 #include <vtkOBJWriter.h>
-#include <vtkPLYReader.h>
 #include <vtkPLYWriter.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
-#include <vtkPolyDataReader.h>
 #include <vtkPolyDataWriter.h>
-#include <vtkSTLReader.h>
 #include <vtkSTLWriter.h>
 #include <vtkSmartPointer.h>
 #include <vtkTriangleFilter.h>
@@ -23,10 +19,15 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include "mesh/atomic_file.h"
 #include "mesh/errors.h"
+#include "mesh/legacy_vtk_reader.h"
+#include "mesh/obj_reader.h"
+#include "mesh/ply_reader.h"
+#include "mesh/stl_reader.h"
 #include "mesh/vtk_convert.h"
 
 namespace mrsnake {
@@ -131,13 +132,18 @@ TriMesh read_mesh(const std::string& path) {
   TriMesh mesh;
   if (ext == ".off") {
     mesh = read_off(path);
+  } else if (ext == ".ply") {
+    mesh = read_ply(path);
+  } else if (ext == ".stl") {
+    mesh = read_stl(path);
+  } else if (ext == ".vtk") {
+    mesh = read_legacy_vtk(path);
+  } else if (ext == ".obj") {
+    mesh = read_obj(path);
   } else {
     vtkSmartPointer<vtkPolyData> poly;
     if (ext == ".vtp") poly = read_with<vtkXMLPolyDataReader>(path);
-    else if (ext == ".vtk") poly = read_with<vtkPolyDataReader>(path);
-    else if (ext == ".stl") poly = read_with<vtkSTLReader>(path);  // merges duplicated corners
-    else if (ext == ".ply") poly = read_with<vtkPLYReader>(path);
-    else if (ext == ".obj") poly = read_with<vtkOBJReader>(path);
+
     else throw InputError("'" + path + "' has an unknown mesh extension '" + ext + "'; use .vtp .vtk .stl .ply .obj or .off");
     if (!poly || poly->GetNumberOfPoints() == 0)
       throw InputError("cannot read a mesh from '" + path + "'; the file may be corrupt, truncated or empty");

@@ -63,7 +63,12 @@ int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F) {
       if (c == d || edge_faces.count({c, d}) || edge_faces.count({d, c}) || created.count({std::min(c, d), std::max(c, d)}))
         continue;
       if (valence[a] <= 3 || valence[b] <= 3) continue;
-      auto dev = [&](int v, int delta) { const double x = valence[v] + delta - target(v); return x * x; };
+      // A rim vertex with too few triangles forces a near-flat angle into them: weigh the
+      // rim three times.
+      auto dev = [&](int v, int delta) {
+        const double x = valence[v] + delta - target(v);
+        return (boundary[v] ? 3.0 : 1.0) * x * x;
+      };
       const double before = dev(a, 0) + dev(b, 0) + dev(c, 0) + dev(d, 0);
       const double after = dev(a, -1) + dev(b, -1) + dev(c, 1) + dev(d, 1);
       if (!(after < before)) continue;

@@ -23,7 +23,7 @@ struct BaseMesh {
 BaseMesh build_base_mesh(const Parameterization& param, int n0);
 
 /// Flips edges (never boundary edges, never making a flipped triangle in D or a duplicate
-/// edge) while that lowers sum (valence - 6)² (boundary: (valence - 4)²).
+/// edge) while that lowers sum (valence - 6)² (boundary: 3·(valence - 4)²).
 /// \return the number of flips made.
 int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F);
 

@@ -18,6 +18,25 @@
 #include "remesh/parameterization.h"
 
 namespace mrsnake {
+namespace {
+
+using EigenMatrix = CGAL::Eigen_sparse_matrix<double>::EigenType;
+using LUTraits = CGAL::Eigen_solver_traits<Eigen::SparseLU<EigenMatrix, Eigen::COLAMDOrdering<int>>>;
+
+// CGAL solves the same matrix for u and for v: factor it once.
+struct CachedLUTraits : LUTraits {
+  const Matrix* factored = nullptr;
+  bool linear_solver(const Matrix& A, const Vector& B, Vector& X, NT& D) {
+    if (factored != &A) {
+      if (!LUTraits::factor(A, D)) return false;
+      factored = &A;
+    }
+    D = 1;
+    return LUTraits::linear_solver(B, X);
+  }
+};
+
+}  // namespace
 
 Eigen::MatrixX2d mean_value_disk_map(const TriMesh& disk) {
   using Kernel = CGAL::Simple_cartesian<double>;
@@ -27,9 +46,7 @@ Eigen::MatrixX2d mean_value_disk_map(const TriMesh& disk) {
   using VertexIndex = SurfaceMesh::Vertex_index;
   namespace SMP = CGAL::Surface_mesh_parameterization;
   using Border = SMP::Circular_border_arc_length_parameterizer_3<SurfaceMesh>;
-  using Matrix = CGAL::Eigen_sparse_matrix<double>::EigenType;
-  using Solver = CGAL::Eigen_solver_traits<Eigen::SparseLU<Matrix, Eigen::COLAMDOrdering<int>>>;
-  using Parameterizer = SMP::Mean_value_coordinates_parameterizer_3<SurfaceMesh, Border, Solver>;
+  using Parameterizer = SMP::Mean_value_coordinates_parameterizer_3<SurfaceMesh, Border, CachedLUTraits>;
 
   SurfaceMesh sm;
   std::vector<VertexIndex> vertex(disk.num_vertices());

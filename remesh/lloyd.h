@@ -25,7 +25,7 @@ struct LloydOptions {
   int iterations = 8;
   int first_movable = 0;        ///< vertices [0, first_movable) stay fixed (the paper's strict mode)
   double step = 1.0;            ///< fraction of the way to the centroid moved per iteration
-  int sample_budget = 400000;   ///< density samples per iteration over all faces
+  int sample_budget = 400000;   ///< density samples per iteration over all faces (coarse levels integrate finely)
 };
 
 struct LloydStats {

@@ -115,7 +115,9 @@ Parameterization parameterize(const TriMesh& input) {
 
   if (topo.is_disk()) {
     param.kind = DomainKind::disk;
+    const auto solve_start = std::chrono::steady_clock::now();
     const Eigen::MatrixX2d uv = mean_value_disk_map(mesh);
+    param.summary["solver_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
     for (int v = 0; v < n; ++v) param.domain.row(v) << 2 * uv(v, 0) - 1, 2 * uv(v, 1) - 1, 1.0;
     double signed_area = 0;
     for (int f = 0; f < mesh.num_faces(); ++f)
@@ -143,7 +145,9 @@ Parameterization parameterize(const TriMesh& input) {
     disk.F.resize(static_cast<int>(keep.size()), 3);
     for (std::size_t i = 0; i < keep.size(); ++i)
       for (int k = 0; k < 3; ++k) disk.F(static_cast<int>(i), k) = to_disk[mesh.F(keep[i], k)];
+    const auto solve_start = std::chrono::steady_clock::now();
     const Eigen::MatrixX2d uv = mean_value_disk_map(disk);
+    param.summary["solver_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
     for (int i = 0; i < n - 1; ++i) {
       // Inverse stereographic projection from the pole (0, 0, 1); the disk's rim goes to the equator.
       const double x = 2 * uv(i, 0) - 1, y = 2 * uv(i, 1) - 1, s = x * x + y * y;

@@ -1,6 +1,8 @@
 #include "remesh/remesh.h"
 
+#include <algorithm>
 #include <chrono>
+#include <memory>
 #include <cmath>
 #include <stdexcept>
 
@@ -13,6 +15,9 @@
 #include "remesh/lloyd.h"
 #include "remesh/parameterization.h"
 #include "remesh/shape_smoothing.h"
+#include "remesh/simplify.h"
+#include "remesh/sizing.h"
+#include "mesh/topology.h"
 
 namespace mrsnake {
 namespace {
@@ -30,11 +35,13 @@ const char* relax_name(RelaxMode mode) {
   return "?";
 }
 
-// Levels L and base size n0 so that F0·4^L is near the target, with F0 in [40, 160).
+// Levels L and base size n0 so that F0·4^L is near the target, with F0 in [128, 512): a base
+// of ~65-260 vertices spread over the shape absorbs its curvature, and since about half of
+// them are irregular, they stay under 1% of the finest level's vertices.
 void choose_resolution(int target_faces, int& levels, int& n0) {
   levels = 1;
   double f0 = target_faces / 4.0;
-  while (f0 >= 160) {
+  while (f0 >= 512) {
     f0 /= 4;
     ++levels;
   }
@@ -54,13 +61,38 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   if (input.empty()) throw InputError("the mesh has no faces");
 
   RemeshResult result;
-  report(options.progress, "parameterize", 0);
-  const Parameterization param = parameterize(input);
-  result.domain = param.kind == DomainKind::sphere ? "sphere" : "disk";
-  result.parameterization = param.summary;
-
+  const auto simplify_start = Clock::now();
+  const TriMesh original = remove_unreferenced_vertices(input);
+  const TopologyReport topology = topology_report(original);
+  require_disk_or_sphere(topology, "the input surface");
   int levels = options.levels, n0 = options.base_vertices;
   if (levels == 0) choose_resolution(options.target_faces, levels, n0);
+
+  // A much finer input is simplified before the (costly) parameterization.
+  TriMesh work = original;
+  std::unique_ptr<SurfaceLocator> reproject;
+  const double finest_faces = 2.0 * n0 * std::pow(4.0, levels);
+  const double limit = std::max<double>(options.simplify_above_faces, 8 * finest_faces);
+  if (options.simplify_above_faces > 0 && original.num_faces() > limit) {
+    report(options.progress, "simplify", 0);
+    TriMesh simplified = simplify_to_faces(original, static_cast<int>(limit));
+    result.parameterization["simplify_seconds"] = seconds_since(simplify_start);
+    const TopologyReport after = topology_report(simplified);
+    if (after.is_disk() == topology.is_disk() && after.is_closed_genus0() == topology.is_closed_genus0()) {
+      work = std::move(simplified);
+      reproject = std::make_unique<SurfaceLocator>(original);
+    }
+  }
+
+  report(options.progress, "parameterize", 0);
+  const Parameterization param = parameterize(work);
+  result.domain = param.kind == DomainKind::sphere ? "sphere" : "disk";
+  const nlohmann::json simplify_info = result.parameterization;
+  result.parameterization = param.summary;
+  if (simplify_info.is_object()) result.parameterization.update(simplify_info);
+  result.parameterization["input_faces"] = original.num_faces();
+  result.parameterization["parameterized_faces"] = work.num_faces();
+  result.parameterization["seconds"] = seconds_since(simplify_start);  // input checks and simplification included
 
   const auto base_start = Clock::now();
   report(options.progress, "base mesh", 0);
@@ -72,7 +104,16 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   result.parameterization["base_valence_flips"] = base.valence_flips;
 
   const DomainMesh domain_mesh(param.domain, param.surface.F);
-  DensityField density{&domain_mesh, param.vertex_stretch.array().pow(options.density_exponent).matrix()};
+  Eigen::VectorXd wanted = Eigen::VectorXd::Ones(param.surface.num_vertices());  // wanted 3D point density
+  if (options.curvature_weight > 0) {
+    const Eigen::VectorXd kappa = vertex_curvature(param.surface, 8);
+    const double mean = kappa.mean();
+    // Capped, so that a few sharp spots (voxel steps of a marching-cubes surface) cannot pull
+    // the spacing down so fast that triangle shapes suffer.
+    if (mean > 0) wanted.array() += options.curvature_weight * (kappa.array() / mean).min(3.0);
+  }
+  DensityField density{&domain_mesh,
+                       param.vertex_stretch.cwiseProduct(wanted).array().pow(options.density_exponent).matrix()};
   const DomainKind kind = param.kind;
 
   RowMatrixX3d U = base.domain;
@@ -98,21 +139,39 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       }
     }
     LloydStats relax_stats;
-    const bool relax = options.relax == RelaxMode::all_vertices ||
-                       (options.relax == RelaxMode::new_vertices_only && j > 0);
-    if (relax) {
-      lloyd.first_movable = options.relax == RelaxMode::new_vertices_only ? result.connectivity.vertex_count(j - 1) : 0;
-      relax_stats = constrained_lloyd(kind, F, density, U, hints, lloyd);
-    }
-    report(options.progress, "level " + std::to_string(j), 0.5);
     RemeshLevel level;
-    level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
     int shape_moves = 0;
     if (options.relax == RelaxMode::all_vertices && options.shape_iterations > 0) {
+      // Lloyd (sizes) and shape smoothing (angles) pull against each other; interleaving
+      // them in rounds balances the two better than running one after the other.
+      const int rounds = options.shape_iterations;
       ShapeSmoothingOptions shape;
-      shape.iterations = options.shape_iterations;
-      shape_moves = smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, shape);
+      shape.iterations = 1;
+      lloyd.first_movable = 0;
+      for (int round = 0; round < rounds; ++round) {
+        lloyd.iterations = options.lloyd_iterations * (round + 1) / rounds - options.lloyd_iterations * round / rounds;
+        const LloydStats s = constrained_lloyd(kind, F, density, U, hints, lloyd);
+        relax_stats.moves += s.moves;
+        relax_stats.shortened_moves += s.shortened_moves;
+        relax_stats.rejected_moves += s.rejected_moves;
+        relax_stats.mean_shift = s.mean_shift;
+        level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
+        shape_moves += smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, shape);
+      }
+    } else {
+      const bool relax = options.relax == RelaxMode::all_vertices ||
+                         (options.relax == RelaxMode::new_vertices_only && j > 0);
+      if (relax) {
+        lloyd.iterations = options.lloyd_iterations;
+        lloyd.first_movable = options.relax == RelaxMode::new_vertices_only ? result.connectivity.vertex_count(j - 1) : 0;
+        relax_stats = constrained_lloyd(kind, F, density, U, hints, lloyd);
+      }
+      level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
     }
+    report(options.progress, "level " + std::to_string(j), 0.5);
+    if (reproject)
+      for (int v = 0; v < level.positions.rows(); ++v)
+        level.positions.row(v) = reproject->closest(level.positions.row(v).transpose()).point.transpose();
     const int flipped = count_flipped(U, F);
     if (flipped > 0)
       throw AlgorithmError("level " + std::to_string(j) + " has " + std::to_string(flipped) +
@@ -133,7 +192,13 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     if (options.compute_stats) {
       const TriMesh mesh{level.positions, F};
       s["quality"] = mesh_quality(mesh);
-      s["distance"] = surface_distance(mesh, param.surface);
+      // Metro-style sampling of both surfaces, capped at ~500k samples per surface: a
+      // marching-cubes input has hundreds of thousands of faces.
+      DistanceOptions sampling;
+      sampling.samples_per_face =
+          std::clamp(static_cast<int>(5e5 / std::max(original.num_faces(), mesh.num_faces())), 1, 10);
+      s["distance"] = surface_distance(mesh, original, sampling);
+      s["distance"]["samples_per_face"] = sampling.samples_per_face;
     }
     result.levels.push_back(std::move(level));
     report(options.progress, "level " + std::to_string(j), 1.0);
@@ -147,6 +212,7 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["levels"] = result.connectivity.levels();
   j["relax"] = relax_name(options.relax);
   j["density_exponent"] = options.density_exponent;
+  j["curvature_weight"] = options.curvature_weight;
   j["lloyd_iterations"] = options.lloyd_iterations;
   j["shape_iterations"] = options.relax == RelaxMode::all_vertices ? options.shape_iterations : 0;
   j["parameterization"] = result.parameterization;

@@ -38,12 +38,19 @@ struct RemeshOptions {
   /// The Lloyd density is stretch^density_exponent, stretch = A3D/A_D. 2 makes the 3D
   /// spacing even (2D Lloyd spaces points as density^(-1/4)).
   double density_exponent = 2.0;
+  /// Curvature sizing: the wanted 3D point density is w = 1 + curvature_weight·κ/mean(κ)
+  /// (remesh/sizing.h) and the Lloyd density (stretch·w)^density_exponent. 0 = even 3D spacing.
+  double curvature_weight = 1.0;
   /// Lloyd iterations per level (level 0 included unless relax == new_vertices_only).
   int lloyd_iterations = 8;
   /// With all_vertices: iterations per level of tangential smoothing toward equilateral 3D
   /// triangles, moved in D (remesh/shape_smoothing.h). The Lloyd step evens out sizes but is
   /// affine invariant, so it cannot repair shear; this can. 0 = the Lloyd step alone.
   int shape_iterations = 3;
+  /// Inputs with more faces than max(simplify_above_faces, 8 x the finest level's faces) are
+  /// simplified to that size before parameterization (remesh/simplify.h); the result is then
+  /// projected back onto the original input. 0 = never simplify.
+  int simplify_above_faces = 100000;
   /// Compute quality and distance per level into RemeshLevel::stats (costs time).
   bool compute_stats = true;
   ProgressFn progress;

@@ -1,0 +1,16 @@
+#pragma once
+/// \file simplify.h
+/// Edge-collapse simplification (CGAL: shortest edge first, midpoint placement) of a fine input before it is
+/// parameterized: a marching-cubes organ surface has hundreds of thousands of faces, far
+/// more than a 16k-face model needs, and the parameterization's sparse solve dominates the
+/// run time. The remeshed vertices are projected back onto the original surface afterwards.
+#include "mesh/trimesh.h"
+
+namespace mrsnake {
+
+/// A simplification of `mesh` to about `target_faces` faces (topology preserved).
+/// \pre mesh is a manifold disk or closed genus-0 surface; target_faces >= 8.
+/// \throw AlgorithmError if CGAL cannot build or simplify the surface.
+TriMesh simplify_to_faces(const TriMesh& mesh, int target_faces);
+
+}  // namespace mrsnake
