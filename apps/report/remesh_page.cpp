@@ -135,7 +135,7 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
   settings.push_back({"levels L", std::to_string(L)});
   settings.push_back({"faces (finest)", std::to_string(result.connectivity.faces.back().rows())});
   settings.push_back({"base vertices n0", std::to_string(result.levels.front().positions.rows())});
-  for (const char* key : {"input", "relax", "density_exponent", "lloyd_iterations", "shape_iterations"})
+  for (const char* key : {"input", "relax", "density_exponent", "curvature_weight", "lloyd_iterations", "shape_iterations"})
     if (r.is_object() && r.contains(key)) settings.push_back({key, setting(r[key])});
   if (result.parameterization.is_object())
     for (const auto& [key, value] : result.parameterization.items())
@@ -223,8 +223,9 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
   // The parametric domain coloured by the stretch.
   page.heading("Parametric domain");
   page.paragraph("The finest level's mesh in the domain D (" + result.domain +
-                 "), each face coloured by its stretch A_3D / A_D (log10): the Lloyd density is this stretch to the "
-                 "power of the density exponent, so red regions of D are sampled densely.");
+                 "), each face coloured by its stretch A_3D / A_D (log10) between the finest level and its domain mesh: "
+                 "red regions of D are sampled densely. The Lloyd density is (stretch·w)^density_exponent, w the "
+                 "curvature sizing (1 with --curvature-weight 0).");
   if (can_render) {
     picture(page, "The domain picture", [&] {
       const std::vector<double> stretch = face_stretch(result, L);
