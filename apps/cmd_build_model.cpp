@@ -2,9 +2,13 @@
 // remeshing and wavelet analysis, written as a model folder (wavelets/model_io.h).
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <optional>
 #include <iostream>
 
 #include "apps/cli.h"
+#include "apps/report/remesh_page.h"
+#include "mesh/atomic_file.h"
 #include "mesh/image_io.h"
 #include "mesh/marching_cubes.h"
 #include "mesh/quality.h"
@@ -21,7 +25,7 @@ void add_build_model_command(CLI::App& app) {
   struct Args {
     std::string labels, output, predict = "butterfly", image;
     int label = 1, levels = 0, faces = 32768, smooth = 20, close_tunnels = 0;
-    bool full_report = false, json = false;
+    bool full_report = false, json = false, compare_unrelaxed = false;
   };
   auto a = std::make_shared<Args>();
   cmd->add_option("--labels", a->labels, "Label volume (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)")->required();
@@ -43,6 +47,8 @@ void add_build_model_command(CLI::App& app) {
                   "Reference intensity image of the labels (same physical space): stores the appearance "
                   "(profiles along the normals, inside/outside statistics) that 'mrsnake segment' matches");
   cmd->add_flag("--full-report", a->full_report, "Quality and distance to the input at every level (slower)");
+  cmd->add_flag("--compare-unrelaxed", a->compare_unrelaxed,
+                "Also remesh without relaxation and compare both in MODEL/report.html (a second remeshing run)");
   cmd->add_flag("--json", a->json, "Print a JSON summary");
   cmd->footer(
       "Example: mrsnake build-model --labels liver-labels.nii.gz --label 255 --image liver.nii.gz -o liver.model "
@@ -119,7 +125,29 @@ void add_build_model_command(CLI::App& app) {
     model.remesh_quality = quality;
     // The manifest records every stage up to the write; the write's own time is printed.
     model.timings = timings;
-    save_model(a->output, model, progress);
+
+    // report.html goes into the model folder with the rest, inside the same atomic write.
+    std::optional<RemeshResult> unrelaxed;
+    if (a->compare_unrelaxed) {
+      RemeshOptions plain = ro;
+      plain.relax = RelaxMode::none;
+      plain.compute_stats = false;
+      unrelaxed = remesh(surface.mesh, plain);
+    }
+    report(progress, "report.html", 0.0);
+    mrsnake::reports::RemeshPageOptions page;
+    page.title = "mrsnake build-model " + std::filesystem::path(a->output).filename().string();
+    page.input = &surface.mesh;
+    page.unrelaxed = unrelaxed ? &*unrelaxed : nullptr;
+    page.report = quality;
+    page.report["input"] = a->labels + " (label " + std::to_string(a->label) + ")";
+    page.timings = timings;
+    const std::string html = mrsnake::reports::remesh_report_html(hierarchy, page);
+    report(progress, "report.html", 1.0);
+    lap("report");
+    save_model(a->output, model, progress, [&html](const std::string& temp_folder) {
+      write_text_file_atomically((std::filesystem::path(temp_folder) / "report.html").string(), html);
+    });
     lap("write");
     const double total = std::chrono::duration<double>(clock::now() - t_start).count();
 

@@ -2,9 +2,11 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "apps/cli.h"
+#include "apps/report/remesh_page.h"
 #include "mesh/atomic_file.h"
 #include "mesh/mesh_io.h"
 #include "remesh/remesh.h"
@@ -14,12 +16,12 @@ namespace mrsnake::cli {
 void add_remesh_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("remesh",
                                  "Remesh a disk or closed genus-0 surface into a nested semi-regular hierarchy "
-                                 "(level_0.vtp ... level_L.vtp and report.json)");
+                                 "(level_0.vtp ... level_L.vtp, report.json and report.html)");
   struct Args {
     std::string mesh, out;
     int levels = 0, faces = 16000, base_vertices = 32, iterations = 8, shape_iterations = 3;
     double exponent = 2.0, curvature = 1.0;
-    bool no_relax = false, strict = false, json = false;
+    bool no_relax = false, strict = false, json = false, compare_unrelaxed = false;
   };
   auto args = std::make_shared<Args>();
   cmd->add_option("MESH", args->mesh, "Input surface (.vtp .vtk .stl .ply .obj .off): a disk or a closed genus-0 surface")
@@ -45,6 +47,9 @@ void add_remesh_command(CLI::App& app) {
   cmd->add_option("--shape-iterations", args->shape_iterations,
                   "Iterations per level of 3D shape smoothing after Lloyd (default 3; not with --strict or --no-relax)")
       ->check(CLI::Range(0, 1000));
+  cmd->add_flag("--compare-unrelaxed", args->compare_unrelaxed,
+                "Also remesh without relaxation (a second run) and compare both in report.html and report.json")
+      ->excludes(no_relax);
   cmd->add_flag("--json", args->json, "Print report.json to stdout");
   cmd->footer("Example: mrsnake remesh liver.vtp -o liver_model --faces 16000");
   cmd->callback([args] {
@@ -62,6 +67,13 @@ void add_remesh_command(CLI::App& app) {
     const RemeshResult result = remesh(input, options);
     nlohmann::json report = remesh_report(result, options);
     report["input"] = args->mesh;
+    std::optional<RemeshResult> unrelaxed;
+    if (args->compare_unrelaxed) {
+      RemeshOptions plain = options;
+      plain.relax = RelaxMode::none;
+      unrelaxed = remesh(input, plain);
+      report["unrelaxed"] = remesh_report(*unrelaxed, plain);
+    }
     // Everything is computed before anything is written, into a temporary folder renamed
     // into place at the end: a failure or an interrupt leaves nothing under DIR.
     AtomicDirectory out(args->out);
@@ -69,6 +81,12 @@ void add_remesh_command(CLI::App& app) {
     for (int j = 0; j <= result.connectivity.levels(); ++j)
       write_mesh((dir / ("level_" + std::to_string(j) + ".vtp")).string(), result.mesh(j));
     write_text_file_atomically((dir / "report.json").string(), report.dump(2) + "\n");
+    mrsnake::reports::RemeshPageOptions page;
+    page.title = "mrsnake remesh " + std::filesystem::path(args->mesh).filename().string();
+    page.input = &input;
+    page.unrelaxed = unrelaxed ? &*unrelaxed : nullptr;
+    page.report = report;
+    mrsnake::reports::write_remesh_report((dir / "report.html").string(), result, page);
     out.commit();
     if (args->json) {
       print_json(report);
@@ -91,7 +109,8 @@ void add_remesh_command(CLI::App& app) {
       }
       table << std::setw(9) << level.flipped_triangles << std::setw(9) << level.seconds << '\n';
     }
-    std::cout << table.str() << "wrote " << result.levels.size() << " levels and report.json to " << args->out << '\n';
+    std::cout << table.str() << "wrote " << result.levels.size() << " levels and report.json and report.html to " << args->out
+              << '\n';
   });
 }
 

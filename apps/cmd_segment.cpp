@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "apps/cli.h"
+#include "apps/report/segment_page.h"
 #include "mesh/atomic_file.h"
 #include "mesh/errors.h"
 #include "mesh/image_io.h"
@@ -28,7 +29,7 @@ void add_segment_command(CLI::App& app) {
   auto a = std::make_shared<Args>();
   cmd->add_option("--image", a->image, "Volume to segment (.nii.gz .nrrd .mha ..., or a DICOM folder)")->required();
   cmd->add_option("--model", a->model, "Shape model folder (made by 'mrsnake build-model')")->required();
-  cmd->add_option("-o,--output", a->output, "Output folder: surface.vtp, labels.nii.gz, levels/level_j.vtp, report.json")
+  cmd->add_option("-o,--output", a->output, "Output folder: surface.vtp, labels.nii.gz, levels/level_j.vtp, report.json, report.html")
       ->required();
   cmd->add_option("--init", a->init, "Initial pose: pose, moments, fit, moments+fit")->capture_default_str();
   cmd->add_option("--force", a->force, "External force: auto (profiles if the model has an appearance), profile, edge")
@@ -41,7 +42,7 @@ void add_segment_command(CLI::App& app) {
       "Example:\n"
       "  mrsnake segment --image case7/image.nii.gz --model heart.model -o case7/seg --truth case7/truth.nii.gz\n"
       "Writes DIR/surface.vtp (final level), DIR/labels.nii.gz (1 inside, on the image's grid),\n"
-      "DIR/levels/level_j.vtp (each level after deformation) and DIR/report.json.");
+      "DIR/levels/level_j.vtp (each level after deformation), DIR/report.json and DIR/report.html.");
   cmd->callback([a] {
     const auto progress = terminal_progress();
     const auto t_load = std::chrono::steady_clock::now();
@@ -89,6 +90,29 @@ void add_segment_command(CLI::App& app) {
       write_mesh((dir / "levels" / ("level_" + std::to_string(l.level) + ".vtp")).string(), l.surface);
     write_volume((dir / "labels.nii.gz").string(), labels, VoxelType::uint8);
     write_text_file_atomically((dir / "report.json").string(), rep.dump(2) + "\n");
+    // The page for people: slices with the contours, a render, convergence per level, timings.
+    report(progress, "report.html", 0.0);
+    mrsnake::reports::SegmentPageInput page;
+    page.title = "mrsnake segment " + std::filesystem::path(a->image).filename().string();
+    page.image = &image;
+    page.surface = &result.surface;
+    if (!a->truth.empty()) {
+      page.truth = &truth;
+      page.truth_label = static_cast<float>(a->truth_label);
+    }
+    for (const LevelOutcome& l : result.levels) {
+      mrsnake::reports::SnakeConvergence c;
+      c.level = l.level;
+      for (const auto& it : l.snake.history) {
+        c.energy.push_back(it.energy);
+        c.external_energy.push_back(it.external_energy);
+        c.internal_energy.push_back(it.internal_energy);
+        c.mean_abs_offset_mm.push_back(it.mean_abs_offset_mm);
+      }
+      page.convergence.push_back(std::move(c));
+    }
+    page.report = rep;
+    mrsnake::reports::write_segment_report((dir / "report.html").string(), page);
     out.commit();
     report(progress, "done", 1.0);
 
@@ -105,7 +129,7 @@ void add_segment_command(CLI::App& app) {
                       rep["scores"]["hd95_mm"].is_null() ? INFINITY : rep["scores"]["hd95_mm"].get<double>());
         info(line);
       }
-      info("wrote " + a->output + "/{surface.vtp, labels.nii.gz, levels/, report.json}");
+      info("wrote " + a->output + "/{surface.vtp, labels.nii.gz, levels/, report.json, report.html}");
     }
   });
 }

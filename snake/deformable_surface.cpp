@@ -90,6 +90,7 @@ SnakeLevelReport DeformableSurface::run(RowMatrixX3d& V, const ExternalSearch& s
     report.energy = report.external_energy + report.internal_energy;
     report.mean_abs_offset_mm = offsets.size() ? offsets.cwiseAbs().mean() : 0.0;
     report.iterations = it;
+    report.history.push_back({report.energy, report.external_energy, report.internal_energy, report.mean_abs_offset_mm});
 
     // Convergence on the matched offsets and the energy, not on raw vertex motion.
     offset_history.push_back(report.mean_abs_offset_mm);

@@ -19,6 +19,7 @@
 /// than 60° in one step, reject the step of their vertices (halved, then dropped). The run stops when the matched offsets and the energy stop changing.
 #include <functional>
 #include <limits>
+#include <vector>
 
 #include "mesh/trimesh.h"
 #include "snake/forces.h"
@@ -57,6 +58,11 @@ struct SnakeLevelReport {
   double mean_abs_offset_mm = 0;///< mean |matched offset| at the end
   int rejected_steps = 0;       ///< vertex steps halved or dropped to prevent a fold
   int flipped_faces = 0;        ///< faces whose normal opposes the start's at the end
+  /// The figures above at every iteration, in order (the convergence plots of report.html).
+  struct Iterate {
+    double energy = 0, external_energy = 0, internal_energy = 0, mean_abs_offset_mm = 0;
+  };
+  std::vector<Iterate> history;
 };
 
 /// The prior of one level: ĥ_v = (U_v·n_v)/ℓ_v on the model's own geometry.

@@ -251,7 +251,8 @@ std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size) {
   return h;
 }
 
-void save_model(const std::string& folder, const ShapeModel& model, const ProgressFn& progress) {
+void save_model(const std::string& folder, const ShapeModel& model, const ProgressFn& progress,
+                const std::function<void(const std::string& temp_folder)>& write_extras) {
   const int L = model.levels();
   if (static_cast<int>(model.level_positions.size()) != L + 1)
     throw std::invalid_argument("save_model: the model needs its levels S_0..S_L (make_model fills them)");
@@ -330,6 +331,7 @@ void save_model(const std::string& folder, const ShapeModel& model, const Progre
     const std::string text = m.dump(2) + "\n";
     return std::vector<std::uint8_t>(text.begin(), text.end());
   }());
+  if (write_extras) write_extras(temp.string());
 
   out.commit();
   report(progress, "write model", 1.0);

@@ -5,6 +5,7 @@
 /// ParaView / 3D Slicer) and optional named sections. Layout and rules: docs/model-format.md.
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -23,9 +24,13 @@ std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size);
 /// Writes the model folder atomically: everything goes to a temporary folder beside it,
 /// which is renamed into place at the end. An existing model folder at that path is replaced.
 /// \pre model.level_positions holds S_0..S_L (as make_model fills it).
+/// `write_extras`, when given, is called with the temporary folder after every model part is
+/// written and before the rename, to add files that are not part of the model (e.g.
+/// report.html); they are not listed in the manifest. What it throws aborts the save.
 /// \throw OutputError if the folder cannot be written, or if the path exists and is not a
 ///        model folder (nothing is removed then).
-void save_model(const std::string& folder, const ShapeModel& model, const ProgressFn& progress = {});
+void save_model(const std::string& folder, const ShapeModel& model, const ProgressFn& progress = {},
+                const std::function<void(const std::string& temp_folder)>& write_extras = {});
 
 struct LoadModelOptions {
   bool level_meshes = false;  ///< also read level_j.vtp into level_positions

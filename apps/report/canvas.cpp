@@ -12,7 +12,7 @@
 #include "mesh/atomic_file.h"
 #include "mesh/errors.h"
 
-namespace mrsnake::report {
+namespace mrsnake::reports {
 
 Canvas::Canvas(int width, int height, Rgb background)
     : width_(width), height_(height), pixels_(static_cast<std::size_t>(width) * height, background) {}
@@ -90,4 +90,4 @@ std::string base64(const std::vector<std::uint8_t>& bytes) {
   return out;
 }
 
-}  // namespace mrsnake::report
+}  // namespace mrsnake::reports

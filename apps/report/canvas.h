@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-namespace mrsnake::report {
+namespace mrsnake::reports {
 
 struct Rgb {
   std::uint8_t r = 0, g = 0, b = 0;
@@ -37,4 +37,4 @@ class Canvas {
 /// Standard base64 of bytes (for data: URIs in self-contained HTML pages).
 std::string base64(const std::vector<std::uint8_t>& bytes);
 
-}  // namespace mrsnake::report
+}  // namespace mrsnake::reports

@@ -3,7 +3,7 @@
 #include "apps/report/canvas.h"
 #include "mesh/atomic_file.h"
 
-namespace mrsnake::report {
+namespace mrsnake::reports {
 
 std::string escape_html(const std::string& text) {
   std::string out;
@@ -72,4 +72,4 @@ std::string HtmlPage::str() const {
 
 void HtmlPage::save(const std::string& path) const { write_text_file_atomically(path, str()); }
 
-}  // namespace mrsnake::report
+}  // namespace mrsnake::reports

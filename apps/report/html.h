@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace mrsnake::report {
+namespace mrsnake::reports {
 
 /// Escapes &, <, >, " and ' for HTML text and attributes.
 std::string escape_html(const std::string& text);
@@ -34,4 +34,4 @@ class HtmlPage {
   std::string body_;
 };
 
-}  // namespace mrsnake::report
+}  // namespace mrsnake::reports

@@ -6,7 +6,7 @@
 
 #include "apps/report/html.h"
 
-namespace mrsnake::report {
+namespace mrsnake::reports {
 namespace {
 
 constexpr int kWidth = 420, kHeight = 260;
@@ -15,8 +15,13 @@ const char* kPalette[] = {"#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd",
 
 std::string number(double v) {
   std::ostringstream s;
-  s.precision(3);
-  s << v;
+  // Whole numbers below a million (counts) in full: "5450" fits the margin, "5.45e+03" does not.
+  if (std::abs(v) < 1e6 && v == std::round(v)) {
+    s << static_cast<long long>(v);
+  } else {
+    s.precision(3);
+    s << v;
+  }
   return s.str();
 }
 
@@ -103,4 +108,4 @@ std::string svg_line_plot(const std::vector<Series>& series, const std::string& 
   return svg.str();
 }
 
-}  // namespace mrsnake::report
+}  // namespace mrsnake::reports

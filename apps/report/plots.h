@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-namespace mrsnake::report {
+namespace mrsnake::reports {
 
 /// A histogram of the values in `bins` equal bins over [lo, hi] (lo == hi: the data range).
 std::string svg_histogram(const std::vector<double>& values, int bins, double lo, double hi, const std::string& title,
@@ -21,4 +21,4 @@ struct Series {
 std::string svg_line_plot(const std::vector<Series>& series, const std::string& title, const std::string& x_label,
                           const std::string& y_label, bool log_y = false);
 
-}  // namespace mrsnake::report
+}  // namespace mrsnake::reports

@@ -18,14 +18,20 @@
 #include <vtkUnsignedCharArray.h>
 #include <vtkWindowToImageFilter.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <cstdlib>
 #include <string>
 
 #include "mesh/errors.h"
 #include "mesh/vtk_convert.h"
 
-namespace mrsnake::report {
+namespace mrsnake::reports {
 
 bool display_available(std::string* why) {
   // Probed once per process: the answer does not change, and repeated connections to a
@@ -42,9 +48,9 @@ bool display_available(std::string* why) {
   return problem.empty();
 }
 
-std::vector<std::uint8_t> render_mesh_png(const TriMesh& mesh, const RenderOptions& options) {
-  std::string why;
-  if (!display_available(&why)) throw Error("cannot render: " + why);
+namespace {
+
+std::vector<std::uint8_t> render_in_this_process(const TriMesh& mesh, const RenderOptions& options) {
 
   vtkNew<vtkRenderer> renderer;
   renderer->SetBackground(1, 1, 1);
@@ -133,4 +139,64 @@ std::vector<std::uint8_t> render_mesh_png(const TriMesh& mesh, const RenderOptio
   return {result->GetPointer(0), result->GetPointer(0) + result->GetNumberOfValues()};
 }
 
-}  // namespace mrsnake::report
+}  // namespace
+
+std::vector<std::uint8_t> render_mesh_png(const TriMesh& mesh, const RenderOptions& options) {
+  std::string why;
+  if (!display_available(&why)) throw Error("cannot render: " + why);
+  // VTK's X window calls abort() when it cannot get a GL context (an X server that goes
+  // away, a visual it does not like). Render in a child process, so that such a failure
+  // costs one picture and not the program.
+  int fds[2];
+  if (pipe(fds) != 0) throw Error(std::string("cannot render: pipe failed: ") + std::strerror(errno));
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t pid = fork();
+  if (pid < 0) {
+    close(fds[0]);
+    close(fds[1]);
+    throw Error(std::string("cannot render: fork failed: ") + std::strerror(errno));
+  }
+  if (pid == 0) {
+    close(fds[0]);
+    int code = 0;
+    try {
+      const std::vector<std::uint8_t> png = render_in_this_process(mesh, options);
+      for (std::size_t done = 0; done < png.size();) {
+        const ssize_t n = write(fds[1], png.data() + done, png.size() - done);
+        if (n <= 0) {
+          code = 3;
+          break;
+        }
+        done += static_cast<std::size_t>(n);
+      }
+    } catch (...) {
+      code = 2;
+    }
+    close(fds[1]);
+    _exit(code);  // no atexit handlers or static destructors of the parent's state
+  }
+  close(fds[1]);
+  std::vector<std::uint8_t> png;
+  std::uint8_t buffer[65536];
+  for (;;) {
+    const ssize_t n = read(fds[0], buffer, sizeof buffer);
+    if (n > 0) {
+      png.insert(png.end(), buffer, buffer + n);
+    } else if (n == 0 || errno != EINTR) {
+      break;
+    }
+  }
+  close(fds[0]);
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (WIFSIGNALED(status))
+    throw Error("the 3D renderer stopped (signal " + std::to_string(WTERMSIG(status)) +
+                "): VTK could not open an OpenGL window on the display");
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || png.size() < 8)
+    throw Error("the 3D renderer failed (exit code " + std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")");
+  return png;
+}
+
+}  // namespace mrsnake::reports

@@ -9,7 +9,7 @@
 
 #include "mesh/trimesh.h"
 
-namespace mrsnake::report {
+namespace mrsnake::reports {
 
 struct RenderOptions {
   int width = 640;
@@ -27,9 +27,10 @@ struct RenderOptions {
 /// is missing.
 bool display_available(std::string* why = nullptr);
 
-/// PNG bytes of a shaded render of the mesh.
+/// PNG bytes of a shaded render of the mesh. The render runs in a forked child process: VTK
+/// aborts when it cannot open an OpenGL window, and that must cost a picture, not the program.
 /// \pre display_available()
-/// \throw Error if no display is available.
+/// \throw Error if no display is available or the renderer failed or stopped.
 std::vector<std::uint8_t> render_mesh_png(const TriMesh& mesh, const RenderOptions& options = {});
 
-}  // namespace mrsnake::report
+}  // namespace mrsnake::reports

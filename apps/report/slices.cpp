@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace mrsnake::report {
+namespace mrsnake::reports {
 namespace {
 
 std::pair<float, float> percentile_window(const Volume& image) {
@@ -114,4 +114,4 @@ Canvas slice_with_contours(const Volume& image, int axis, double position, const
   return canvas;
 }
 
-}  // namespace mrsnake::report
+}  // namespace mrsnake::reports

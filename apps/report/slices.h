@@ -8,7 +8,7 @@
 #include "mesh/trimesh.h"
 #include "mesh/volume.h"
 
-namespace mrsnake::report {
+namespace mrsnake::reports {
 
 /// A surface drawn as its intersection with the slice plane.
 struct MeshContour {
@@ -35,4 +35,4 @@ Canvas slice_with_contours(const Volume& image, int axis, double position, const
 /// The continuous voxel index of the centroid of a mesh's vertices (a natural slice centre).
 std::array<double, 3> mesh_centre_index(const Volume& image, const TriMesh& mesh);
 
-}  // namespace mrsnake::report
+}  // namespace mrsnake::reports

@@ -11,7 +11,7 @@
 #include "tests/test_support.h"
 
 using namespace mrsnake;
-using namespace mrsnake::report;
+using namespace mrsnake::reports;
 
 namespace {
 bool is_png(const std::vector<std::uint8_t>& b) {

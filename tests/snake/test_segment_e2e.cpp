@@ -19,6 +19,7 @@
 #include "tests/test_support.h"
 #include "wavelets/model_io.h"
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include "snake/image_pyramid.h"
 #include "snake/rasterize.h"
@@ -176,8 +177,22 @@ TEST(SegmentCommand, WritesEveryOutputOnTheImageGridWithScores) {
                                             (dir / "blob.model").string() + " -o " + (dir / "seg").string() +
                                             " --truth " + (dir / "truth.nii.gz").string() + " --json -q");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  for (const char* f : {"surface.vtp", "labels.nii.gz", "report.json", "levels/level_0.vtp", "levels/level_4.vtp"})
+  for (const char* f : {"surface.vtp", "labels.nii.gz", "report.json", "report.html", "levels/level_0.vtp", "levels/level_4.vtp"})
     EXPECT_TRUE(std::filesystem::exists(dir / "seg" / f)) << f;
+  {
+    // The page: three slices, a convergence plot per level plus the offsets of all levels.
+    std::ifstream page_in(dir / "seg" / "report.html");
+    const std::string page((std::istreambuf_iterator<char>(page_in)), std::istreambuf_iterator<char>());
+    const auto count = [&](const std::string& what) {
+      int n = 0;
+      for (auto at = page.find(what); at != std::string::npos; at = page.find(what, at + 1)) ++n;
+      return n;
+    };
+    EXPECT_EQ(count("<h2>Slices</h2>"), 1);
+    EXPECT_EQ(count("<h2>Scores against the truth</h2>"), 1);
+    EXPECT_EQ(count("<svg"), 5 + 1);
+    EXPECT_GE(count("<img"), 3);
+  }
   const Volume labels = read_volume((dir / "seg" / "labels.nii.gz").string());
   EXPECT_EQ(labels.size, image.size);
   for (int a = 0; a < 3; ++a) {

@@ -400,4 +400,13 @@ TEST(Snake, ConvergesOntoASphereInAVolume) {
   const Eigen::VectorXd radii = (V.rowwise() - c.transpose()).rowwise().norm();
   EXPECT_NEAR(radii.mean(), 14.0, 0.15);  // the prior is scale invariant: no shrinkage
   EXPECT_LT(radii.maxCoeff() - radii.minCoeff(), 0.6);
+  // One history entry per iteration, the last one the report's final figures; the offsets
+  // shrink from 3 mm (11 to 14) towards the edge.
+  ASSERT_FALSE(rep.history.empty());
+  EXPECT_LE(static_cast<int>(rep.history.size()), rep.iterations + 1);
+  EXPECT_GE(static_cast<int>(rep.history.size()), rep.iterations);
+  EXPECT_DOUBLE_EQ(rep.history.back().energy, rep.energy);
+  EXPECT_DOUBLE_EQ(rep.history.back().mean_abs_offset_mm, rep.mean_abs_offset_mm);
+  EXPECT_GT(rep.history.front().mean_abs_offset_mm, 2.0);
+  EXPECT_LT(rep.history.back().mean_abs_offset_mm, 0.5 * rep.history.front().mean_abs_offset_mm);
 }

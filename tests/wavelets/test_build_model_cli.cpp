@@ -43,7 +43,7 @@ TEST(BuildModelCli, BuildsAModelThatModelInfoAccepts) {
   EXPECT_GE(summary["faces"].get<int>(), 1024);
   std::vector<std::string> stages;
   for (const auto& t : summary["timings"]) stages.push_back(t["stage"]);
-  EXPECT_EQ(stages, (std::vector<std::string>{"read", "marching_cubes", "parameterization", "levels", "analysis", "write"}));
+  EXPECT_EQ(stages, (std::vector<std::string>{"read", "marching_cubes", "parameterization", "levels", "analysis", "report", "write"}));
 
   const ShapeModel m = load_model(model, {true});
   EXPECT_EQ(m.source_label, 3);

@@ -1,0 +1,188 @@
+#include "apps/report/segment_page.h"
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <stdexcept>
+
+#include "apps/report/html.h"
+#include "apps/report/plots.h"
+#include "apps/report/render.h"
+#include "apps/report/slices.h"
+#include "mesh/atomic_file.h"
+#include "mesh/marching_cubes.h"
+
+namespace mrsnake::reports {
+namespace {
+
+std::string text(const nlohmann::json& v, int digits = 4) {
+  if (v.is_null()) return "–";
+  if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
+  if (v.is_number_integer()) return std::to_string(v.get<long long>());
+  if (v.is_number()) {
+    char buf[64];
+    const double x = v.get<double>();
+    if (std::abs(x) >= 1e4 && std::abs(x) < 1e12)
+      std::snprintf(buf, sizeof buf, "%.0f", x);  // volumes in mm³: no exponent
+    else
+      std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+    return buf;
+  }
+  if (v.is_string()) return v.get<std::string>();
+  if (v.is_array()) {
+    std::string out;
+    for (const auto& e : v) out += (out.empty() ? "" : ", ") + text(e, digits);
+    return out;
+  }
+  return v.dump();
+}
+
+template <class Make>
+void picture(HtmlPage& page, const std::string& what, Make&& make) {
+  try {
+    make();
+  } catch (const std::exception& e) {
+    page.note(what + " could not be drawn: " + e.what());
+  }
+}
+
+std::vector<double> iterations(std::size_t n) {
+  std::vector<double> x(n);
+  for (std::size_t i = 0; i < n; ++i) x[i] = static_cast<double>(i);
+  return x;
+}
+
+}  // namespace
+
+std::string segment_report_html(const SegmentPageInput& in) {
+  if (!in.image || !in.surface) throw std::invalid_argument("segment_report_html: the image and the surface are required");
+  HtmlPage page(in.title);
+  const nlohmann::json& r = in.report;
+
+  // Summary and scores.
+  std::vector<std::vector<std::string>> summary;
+  for (const char* key : {"image", "model", "truth", "force", "init", "vertices", "faces", "converged", "final_energy",
+                          "self_intersections", "compute_seconds"})
+    if (r.is_object() && r.contains(key)) summary.push_back({key, text(r[key])});
+  if (r.is_object() && r.contains("initial_pose") && r["initial_pose"].is_object())
+    for (const auto& [key, value] : r["initial_pose"].items()) summary.push_back({"initial pose " + key, text(value)});
+  page.heading("Summary");
+  page.table({"item", "value"}, summary);
+  if (r.is_object() && r.contains("scores") && r["scores"].is_object()) {
+    std::vector<std::vector<std::string>> scores;
+    for (const auto& [key, value] : r["scores"].items()) scores.push_back({key, text(value)});
+    page.heading("Scores against the truth");
+    page.table({"score", "value"}, scores);
+  }
+
+  // Slices.
+  page.heading("Slices");
+  std::vector<LabelContour> label_contours;
+  if (in.truth) label_contours.push_back({in.truth, in.truth_label, {64, 220, 64}, "truth"});
+  page.paragraph(std::string("Three orthogonal slices through the centre of the final surface: the final contour in red") +
+                 (in.truth ? ", the truth's outline in green (hidden under the red where the two agree)." : ". (No --truth was given.)"));
+  page.begin_figures();
+  const char* axis_names[] = {"sagittal (x)", "coronal (y)", "axial (z)"};
+  std::array<double, 3> centre{};
+  picture(page, "The slice centre", [&] { centre = mesh_centre_index(*in.image, *in.surface); });
+  for (int axis = 0; axis < 3; ++axis)
+    picture(page, std::string("The ") + axis_names[axis] + " slice", [&] {
+      const Canvas c = slice_with_contours(*in.image, axis, centre[axis], {{in.surface, {255, 64, 64}, "segmentation"}},
+                                           label_contours, 360);
+      char caption[96];
+      std::snprintf(caption, sizeof caption, "%s slice at voxel %.0f", axis_names[axis], std::round(centre[axis]));
+      page.png(c.png(), caption);
+    });
+  page.end_figures();
+
+  // 3D render.
+  page.heading("Surface");
+  std::string why;
+  const bool can_render = in.renders && display_available(&why);
+  if (!in.renders) why = "3D renders were turned off";
+  if (!can_render) {
+    page.note("No 3D render of the surface: " + why + ".");
+  } else {
+    picture(page, "The 3D render", [&] {
+      TriMesh truth_surface;
+      RenderOptions ro;
+      ro.width = 560;
+      ro.height = 460;
+      ro.wireframe = in.surface->num_faces() <= 40000;
+      if (in.truth) {
+        truth_surface = extract_label_surface(*in.truth, static_cast<int>(std::lround(in.truth_label))).mesh;
+        ro.overlay = &truth_surface;
+      }
+      page.begin_figures();
+      page.png(render_mesh_png(*in.surface, ro),
+               std::string("final surface") + (in.truth ? " with the truth surface in translucent green" : ""));
+      ro.azimuth += 180;
+      page.png(render_mesh_png(*in.surface, ro), "the other side");
+      page.end_figures();
+    });
+  }
+
+  // Convergence.
+  page.heading("Convergence");
+  if (in.convergence.empty()) {
+    page.note("No convergence history was recorded.");
+  } else {
+    page.paragraph("Energy (mean matched cost plus the internal term) and the mean |matched offset| along the normals "
+                   "at each iteration of each level.");
+    page.begin_figures();
+    for (const SnakeConvergence& c : in.convergence)
+      picture(page, "The convergence plot of level " + std::to_string(c.level), [&] {
+        std::vector<Series> series;
+        if (!c.energy.empty()) series.push_back({"energy", iterations(c.energy.size()), c.energy});
+        if (!c.external_energy.empty()) series.push_back({"external", iterations(c.external_energy.size()), c.external_energy});
+        if (!c.internal_energy.empty()) series.push_back({"internal", iterations(c.internal_energy.size()), c.internal_energy});
+        if (series.empty()) throw std::runtime_error("no iterations were recorded");
+        page.svg(svg_line_plot(series, "Level " + std::to_string(c.level) + " energy", "iteration", "energy"),
+                 "level " + std::to_string(c.level) + ": " + std::to_string(c.energy.size()) + " iterations");
+      });
+    picture(page, "The offset plot", [&] {
+      std::vector<Series> series;
+      for (const SnakeConvergence& c : in.convergence)
+        if (!c.mean_abs_offset_mm.empty())
+          series.push_back({"level " + std::to_string(c.level), iterations(c.mean_abs_offset_mm.size()), c.mean_abs_offset_mm});
+      if (series.empty()) throw std::runtime_error("no offsets were recorded");
+      page.svg(svg_line_plot(series, "Mean |matched offset|", "iteration", "mm"), "mean |matched offset| per level");
+    });
+    page.end_figures();
+  }
+
+  // Levels and timings.
+  if (r.is_object() && r.contains("levels") && r["levels"].is_array() && !r["levels"].empty()) {
+    const std::vector<std::pair<const char*, const char*>> columns = {
+        {"level", "level"}, {"vertices", "vertices"}, {"pyramid_level", "pyramid level"}, {"voxel_mm", "voxel (mm)"},
+        {"search_range_mm", "search range (mm)"}, {"iterations", "iterations"}, {"converged", "converged"},
+        {"energy", "energy"}, {"mean_abs_offset_mm", "mean |offset| (mm)"}, {"rejected_steps", "rejected steps"},
+        {"flipped_faces", "flipped faces"}, {"synthesis_seconds", "synthesis (s)"}, {"seconds", "seconds"}};
+    std::vector<std::string> header;
+    for (const auto& c : columns) header.push_back(c.second);
+    std::vector<std::vector<std::string>> rows;
+    for (const auto& level : r["levels"]) {
+      std::vector<std::string> row;
+      for (const auto& c : columns) row.push_back(level.contains(c.first) ? text(level[c.first]) : "–");
+      rows.push_back(row);
+    }
+    page.heading("Levels");
+    page.table(header, rows);
+  }
+  page.heading("Timings");
+  if (r.is_object() && r.contains("stage_seconds") && r["stage_seconds"].is_object() && !r["stage_seconds"].empty()) {
+    std::vector<std::vector<std::string>> rows;
+    for (const auto& [stage, seconds] : r["stage_seconds"].items()) rows.push_back({stage, text(seconds)});
+    page.table({"stage", "seconds"}, rows);
+  } else {
+    page.note("No timings were recorded.");
+  }
+  return page.str();
+}
+
+void write_segment_report(const std::string& path, const SegmentPageInput& input) {
+  write_text_file_atomically(path, segment_report_html(input));
+}
+
+}  // namespace mrsnake::reports
