@@ -146,8 +146,21 @@ struct ChildRun {
   int exit_code = -1;  ///< -1 if it did not exit normally (signal, timeout, exec failure)
   bool timed_out = false;
   double seconds = 0;
-  double peak_mib = 0;  ///< the child's peak RSS (wait4)
+  double cpu_seconds = 0;  ///< the child's user + system time (wait4)
+  double peak_mib = 0;     ///< the child's peak RSS (wait4)
 };
+
+double cpu_seconds_of(const struct rusage& u) {
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+/// User + system time of the calling thread so far.
+double thread_cpu_seconds() {
+  struct rusage u {};
+  getrusage(RUSAGE_THREAD, &u);
+  return cpu_seconds_of(u);
+}
 
 /// Runs a program with its output going to log_path; waits up to timeout seconds.
 ChildRun run_child(const std::vector<std::string>& args, const std::string& log_path, double timeout) {
@@ -184,6 +197,7 @@ ChildRun run_child(const std::vector<std::string>& args, const std::string& log_
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  r.cpu_seconds = cpu_seconds_of(usage);
   r.peak_mib = static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
   if (!r.timed_out && WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
   return r;
@@ -268,6 +282,7 @@ double total_area(const TriMesh& m) {
 struct CgalRun {
   TriMesh mesh;
   double seconds = 0;     ///< the isotropic_remeshing call that produced `mesh`
+  double cpu_seconds = 0; ///< its user + system time
   double peak_mib = 0;    ///< process peak RSS during that call
   double rss_before_mib = 0;
   double target_edge_length = 0;
@@ -283,10 +298,12 @@ CgalRun cgal_remesh_once(const TriMesh& input, double edge_length, int iteration
   r.rss_before_mib = proc_status_mib("VmRSS");
   SurfaceMesh sm = to_surface_mesh(input);
   const auto start = Clock::now();
+  const double cpu_start = thread_cpu_seconds();
   CGAL::Polygon_mesh_processing::isotropic_remeshing(
       faces(sm), edge_length, sm,
       CGAL::parameters::number_of_iterations(static_cast<unsigned>(iterations)).protect_constraints(false));
   r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  r.cpu_seconds = thread_cpu_seconds() - cpu_start;
   sm.collect_garbage();
   r.peak_mib = reset ? proc_status_mib("VmHWM") : std::nan("");
   r.mesh = to_trimesh(sm);
@@ -314,10 +331,11 @@ struct Row {
   int target = 0;
   std::string status = "ok";  ///< "ok", or why there are no figures
   int faces = 0, level = -1;
-  double seconds = 0, peak_mib = 0;
+  double seconds = 0, cpu_seconds = 0, peak_mib = 0;
   std::optional<QualityReport> quality;
   std::optional<SurfaceDistance> distance;
   double speed_ratio = std::nan("");  ///< CGAL's seconds / this row's seconds (> 1: faster than CGAL)
+  double cpu_speed_ratio = std::nan("");  ///< the same with user + system time
   json extra = json::object();
 };
 
@@ -367,6 +385,7 @@ Row run_mrsnake_remesh(const Options& o, const std::string& name, const std::str
   const std::string log = (dir / "mrsnake.log").string();
   const ChildRun child = run_child(args, log, o.timeout);
   row.seconds = child.seconds;
+  row.cpu_seconds = child.cpu_seconds;
   row.peak_mib = child.peak_mib;
   if (child.timed_out) {
     row.status = "timed out after " + std::to_string(static_cast<int>(o.timeout)) + " s";
@@ -418,8 +437,9 @@ Row run_cgal(const Options& o, const std::string& name, const TriMesh& input, in
   try {
     const CgalRun r = cgal_remesh(input, target, o.iterations);
     row.seconds = r.seconds;
+    row.cpu_seconds = r.cpu_seconds;
     row.peak_mib = r.peak_mib;
-    row.speed_ratio = 1.0;
+    row.speed_ratio = row.cpu_speed_ratio = 1.0;
     measure(row, r.mesh, input, o.samples);
     row.extra = {{"iterations", o.iterations},
                  {"target_edge_length", r.target_edge_length},
@@ -439,18 +459,20 @@ json row_json(const Row& r) {
   if (r.status != "ok") return j;
   j["faces"] = r.faces;
   j["seconds"] = r.seconds;
+  j["cpu_seconds"] = r.cpu_seconds;
   j["peak_mib"] = std::isnan(r.peak_mib) ? json(nullptr) : json(r.peak_mib);
   if (r.level >= 0) j["level"] = r.level;
   if (r.quality) j["quality"] = *r.quality;
   if (r.distance) j["distance"] = *r.distance;
   j["speed_ratio_vs_cgal"] = std::isnan(r.speed_ratio) ? json(nullptr) : json(r.speed_ratio);
+  j["cpu_speed_ratio_vs_cgal"] = std::isnan(r.cpu_speed_ratio) ? json(nullptr) : json(r.cpu_speed_ratio);
   for (const auto& [k, v] : r.extra.items()) j[k] = v;
   return j;
 }
 
 void print_header() {
-  std::printf("%-9s %6s %-16s %7s %8s %8s %7s %7s %6s %6s %7s %7s %6s\n", "input", "target", "method", "faces",
-              "seconds", "peakMiB", "val6%", "minang", "Qmin", "Qmean", "RMS%", "Haus%", "speed");
+  std::printf("%-9s %6s %-16s %7s %8s %7s %8s %7s %7s %6s %6s %7s %7s %6s\n", "input", "target", "method", "faces",
+              "seconds", "cpu_s", "peakMiB", "val6%", "minang", "Qmin", "Qmean", "RMS%", "Haus%", "speed");
 }
 
 void print_row(const Row& r) {
@@ -459,7 +481,7 @@ void print_row(const Row& r) {
     std::printf("%s\n", r.status.c_str());
     return;
   }
-  std::printf("%7d %8.2f %8.1f %7.2f %7.2f %6.3f %6.3f %7.4f %7.4f ", r.faces, r.seconds, r.peak_mib,
+  std::printf("%7d %8.2f %7.2f %8.1f %7.2f %7.2f %6.3f %6.3f %7.4f %7.4f ", r.faces, r.seconds, r.cpu_seconds, r.peak_mib,
               r.quality->pct_valence6_interior, r.quality->min_angle_deg, r.quality->q_min, r.quality->q_mean,
               r.distance->rms_pct, r.distance->hausdorff_pct);
   if (std::isnan(r.speed_ratio)) std::printf("%6s\n", "-");
@@ -555,7 +577,10 @@ int main(int argc, char** argv) {
       std::cerr << label << " " << target << ": mrsnake --no-relax...\n";
       Row plain = run_mrsnake_remesh(o, label, path, input, target, false, remesh_available);
       for (Row* r : {&relaxed, &plain})
-        if (r->status == "ok" && cgal.status == "ok" && r->seconds > 0) r->speed_ratio = cgal.seconds / r->seconds;
+        if (r->status == "ok" && cgal.status == "ok" && r->seconds > 0) {
+          r->speed_ratio = cgal.seconds / r->seconds;
+          if (r->cpu_seconds > 0) r->cpu_speed_ratio = cgal.cpu_seconds / r->cpu_seconds;
+        }
       rows.push_back(relaxed);
       rows.push_back(plain);
       rows.push_back(cgal);
@@ -567,7 +592,8 @@ int main(int argc, char** argv) {
   std::printf("mrsnake: wall time and peak RSS of the whole 'mrsnake remesh' command (subprocess);\n"
               "CGAL: the isotropic_remeshing call in process, peak RSS of this process during it.\n"
               "val6%% = interior vertices of valence 6; RMS%%, Haus%% = symmetric distance to the input in %% of\n"
-              "its bounding-box diagonal (%d samples per face + vertices); speed = CGAL seconds / seconds.\n\n",
+              "its bounding-box diagonal (%d samples per face + vertices); cpu_s = user + system time;\n"
+              "speed = CGAL seconds / seconds (wall; > 1 is faster than CGAL; the JSON also has the CPU ratio).\n\n",
               o.samples);
   print_header();
   for (const Row& r : rows) print_row(r);
