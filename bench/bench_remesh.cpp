@@ -347,8 +347,10 @@ void measure(Row& row, const TriMesh& output, const TriMesh& input, int samples)
   row.distance = surface_distance(output, input, options);
 }
 
-/// Sum of the per-level and parameterization seconds of report.json, if it has them.
+/// The remesher's own time from report.json: its top-level "seconds", else the sum of the
+/// parameterization's and every level's "seconds" (under "per_level" or "levels").
 std::optional<double> internal_seconds(const json& report) {
+  if (report.contains("seconds") && report["seconds"].is_number()) return report["seconds"].get<double>();
   double total = 0;
   bool found = false;
   if (report.contains("parameterization") && report["parameterization"].is_object() &&
@@ -356,12 +358,13 @@ std::optional<double> internal_seconds(const json& report) {
     total += report["parameterization"]["seconds"].get<double>();
     found = true;
   }
-  if (report.contains("levels") && report["levels"].is_array())
-    for (const auto& level : report["levels"])
-      if (level.is_object() && level.contains("seconds") && level["seconds"].is_number()) {
-        total += level["seconds"].get<double>();
-        found = true;
-      }
+  for (const char* key : {"per_level", "levels"})
+    if (report.contains(key) && report[key].is_array())
+      for (const auto& level : report[key])
+        if (level.is_object() && level.contains("seconds") && level["seconds"].is_number()) {
+          total += level["seconds"].get<double>();
+          found = true;
+        }
   if (!found) return std::nullopt;
   return total;
 }
