@@ -9,8 +9,8 @@
 //   mrsnake remesh INPUT -o DIR --faces N [--no-relax]  ->  DIR/level_0.vtp ... level_L.vtp, report.json
 // (wall time of the whole command and the child's peak RSS from wait4), and the level whose
 // face count is nearest N is measured. CGAL runs in this process (10 iterations, constraints
-// not protected) with a target edge length from the equilateral estimate, corrected once;
-// its peak RSS is the process's high-water mark during the call (reset before it).
+// not protected) with a target edge length from the equilateral estimate, corrected once,
+// aimed at the face count of mrsnake's measured level (at N if mrsnake has none); its peak RSS is the process's high-water mark during the call (reset before it).
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/remesh.h>
 #include <CGAL/Surface_mesh.h>
@@ -334,6 +334,7 @@ struct Row {
   double seconds = 0, cpu_seconds = 0, peak_mib = 0;
   std::optional<QualityReport> quality;
   std::optional<SurfaceDistance> distance;
+  int self_intersections = -1;  ///< pairs of intersecting faces; -1 if not counted
   double speed_ratio = std::nan("");  ///< CGAL's seconds / this row's seconds (> 1: faster than CGAL)
   double cpu_speed_ratio = std::nan("");  ///< the same with user + system time
   json extra = json::object();
@@ -345,6 +346,11 @@ void measure(Row& row, const TriMesh& output, const TriMesh& input, int samples)
   DistanceOptions options;
   options.samples_per_face = samples;
   row.distance = surface_distance(output, input, options);
+  try {
+    row.self_intersections = count_self_intersections(output);
+  } catch (const std::exception& e) {
+    row.extra["self_intersections_error"] = e.what();
+  }
 }
 
 /// The remesher's own time from report.json: its top-level "seconds", else the sum of the
@@ -432,24 +438,27 @@ Row run_mrsnake_remesh(const Options& o, const std::string& name, const std::str
   return row;
 }
 
-Row run_cgal(const Options& o, const std::string& name, const TriMesh& input, int target) {
+/// CGAL aimed at `faces` (the face count mrsnake reached, so both are compared at the same
+/// size; the target N when mrsnake has no result). The row is still filed under `target`.
+Row run_cgal(const Options& o, const std::string& name, const TriMesh& input, int target, int faces) {
   Row row;
   row.input = name;
   row.target = target;
   row.method = "cgal-isotropic";
   try {
-    const CgalRun r = cgal_remesh(input, target, o.iterations);
+    const CgalRun r = cgal_remesh(input, faces, o.iterations);
     row.seconds = r.seconds;
     row.cpu_seconds = r.cpu_seconds;
     row.peak_mib = r.peak_mib;
     row.speed_ratio = row.cpu_speed_ratio = 1.0;
     measure(row, r.mesh, input, o.samples);
-    row.extra = {{"iterations", o.iterations},
+    row.extra.update(json{{"iterations", o.iterations},
+                          {"aimed_faces", faces},
                  {"target_edge_length", r.target_edge_length},
                  {"probe_edge_length", r.probe_edge_length},
                  {"probe_faces", r.probe_faces},
                  {"probe_seconds", r.probe_seconds},
-                 {"rss_before_mib", r.rss_before_mib}};
+                 {"rss_before_mib", r.rss_before_mib}});
     write_mesh((fs::path(o.out) / name / ("cgal-isotropic-" + std::to_string(target) + ".vtp")).string(), r.mesh);
   } catch (const std::exception& e) {
     row.status = std::string("failed: ") + e.what();
@@ -467,6 +476,7 @@ json row_json(const Row& r) {
   if (r.level >= 0) j["level"] = r.level;
   if (r.quality) j["quality"] = *r.quality;
   if (r.distance) j["distance"] = *r.distance;
+  if (r.self_intersections >= 0) j["self_intersections"] = r.self_intersections;
   j["speed_ratio_vs_cgal"] = std::isnan(r.speed_ratio) ? json(nullptr) : json(r.speed_ratio);
   j["cpu_speed_ratio_vs_cgal"] = std::isnan(r.cpu_speed_ratio) ? json(nullptr) : json(r.cpu_speed_ratio);
   for (const auto& [k, v] : r.extra.items()) j[k] = v;
@@ -474,8 +484,8 @@ json row_json(const Row& r) {
 }
 
 void print_header() {
-  std::printf("%-9s %6s %-16s %7s %8s %7s %8s %7s %7s %6s %6s %7s %7s %6s\n", "input", "target", "method", "faces",
-              "seconds", "cpu_s", "peakMiB", "val6%", "minang", "Qmin", "Qmean", "RMS%", "Haus%", "speed");
+  std::printf("%-9s %6s %-16s %7s %8s %7s %8s %7s %7s %6s %6s %7s %7s %5s %6s\n", "input", "target", "method", "faces",
+              "seconds", "cpu_s", "peakMiB", "val6%", "minang", "Qmin", "Qmean", "RMS%", "Haus%", "selfX", "speed");
 }
 
 void print_row(const Row& r) {
@@ -487,6 +497,8 @@ void print_row(const Row& r) {
   std::printf("%7d %8.2f %7.2f %8.1f %7.2f %7.2f %6.3f %6.3f %7.4f %7.4f ", r.faces, r.seconds, r.cpu_seconds, r.peak_mib,
               r.quality->pct_valence6_interior, r.quality->min_angle_deg, r.quality->q_min, r.quality->q_mean,
               r.distance->rms_pct, r.distance->hausdorff_pct);
+  if (r.self_intersections >= 0) std::printf("%5d ", r.self_intersections);
+  else std::printf("%5s ", "-");
   if (std::isnan(r.speed_ratio)) std::printf("%6s\n", "-");
   else std::printf("%6.2f\n", r.speed_ratio);
 }
@@ -573,12 +585,13 @@ int main(int argc, char** argv) {
                            {"topology", topo.describe()},
                            {"diagonal_mm", bounding_box_diagonal(input.V)}});
     for (int target : o.targets) {
-      std::cerr << label << " " << target << ": cgal-isotropic...\n";
-      Row cgal = run_cgal(o, label, input, target);
       std::cerr << label << " " << target << ": mrsnake...\n";
       Row relaxed = run_mrsnake_remesh(o, label, path, input, target, true, remesh_available);
       std::cerr << label << " " << target << ": mrsnake --no-relax...\n";
       Row plain = run_mrsnake_remesh(o, label, path, input, target, false, remesh_available);
+      const int aim = relaxed.status == "ok" ? relaxed.faces : target;
+      std::cerr << label << " " << target << ": cgal-isotropic (aiming at " << aim << " faces)...\n";
+      Row cgal = run_cgal(o, label, input, target, aim);
       for (Row* r : {&relaxed, &plain})
         if (r->status == "ok" && cgal.status == "ok" && r->seconds > 0) {
           r->speed_ratio = cgal.seconds / r->seconds;
@@ -593,9 +606,11 @@ int main(int argc, char** argv) {
   std::printf("\nRemeshing benchmark: mrsnake remesh against CGAL isotropic_remeshing (%d iterations)\n",
               o.iterations);
   std::printf("mrsnake: wall time and peak RSS of the whole 'mrsnake remesh' command (subprocess);\n"
-              "CGAL: the isotropic_remeshing call in process, peak RSS of this process during it.\n"
+              "CGAL: the isotropic_remeshing call in process, peak RSS of this process during it; its edge\n"
+              "length is tuned to the face count of mrsnake's level (else to the target).\n"
               "val6%% = interior vertices of valence 6; RMS%%, Haus%% = symmetric distance to the input in %% of\n"
-              "its bounding-box diagonal (%d samples per face + vertices); cpu_s = user + system time;\n"
+              "its bounding-box diagonal (%d samples per face + vertices); selfX = pairs of intersecting faces;\n"
+              "cpu_s = user + system time;\n"
               "speed = CGAL seconds / seconds (wall; > 1 is faster than CGAL; the JSON also has the CPU ratio).\n\n",
               o.samples);
   print_header();
