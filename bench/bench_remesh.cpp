@@ -536,6 +536,19 @@ int main(int argc, char** argv) {
 
   std::vector<Row> rows;
   json inputs_json = json::array();
+  int inputs_read = 0;
+  // An input that cannot be read still gets its rows, saying why.
+  auto skip_input = [&](const std::string& name, const std::string& why) {
+    for (int t : o.targets)
+      for (const char* m : {"mrsnake", "mrsnake-norelax", "cgal-isotropic"}) {
+        Row r;
+        r.input = name;
+        r.target = t;
+        r.method = m;
+        r.status = why;
+        rows.push_back(r);
+      }
+  };
   for (const std::string& name : o.inputs) {
     // Resolve the input file.
     std::string path;
@@ -549,15 +562,7 @@ int main(int argc, char** argv) {
       if (mc.exit_code != 0) {
         const std::string why = "skipped: 'mrsnake mc' failed (" + last_line_of((fs::path(o.out) / "liver-mc.log").string()) + ")";
         std::cerr << "liver: " << why << "\n";
-        for (int t : o.targets)
-          for (const char* m : {"mrsnake", "mrsnake-norelax", "cgal-isotropic"}) {
-            Row r;
-            r.input = "liver";
-            r.target = t;
-            r.method = m;
-            r.status = why;
-            rows.push_back(r);
-          }
+        skip_input("liver", why);
         inputs_json.push_back({{"name", "liver"}, {"status", why}});
         continue;
       }
@@ -572,9 +577,11 @@ int main(int argc, char** argv) {
       input = read_mesh(path);
     } catch (const std::exception& e) {
       std::cerr << label << ": skipped: " << e.what() << "\n";
+      skip_input(label, std::string("skipped: ") + e.what());
       inputs_json.push_back({{"name", label}, {"file", path}, {"status", std::string("skipped: ") + e.what()}});
       continue;
     }
+    ++inputs_read;
     fs::create_directories(fs::path(o.out) / label);
     const TopologyReport topo = topology_report(input);
     inputs_json.push_back({{"name", label},
@@ -630,6 +637,10 @@ int main(int argc, char** argv) {
   try {
     write_text_file_atomically(json_path, j.dump(2) + "\n");
     std::printf("\nwrote %s\n", json_path.c_str());
+    if (inputs_read == 0) {
+      std::cerr << "bench_remesh: no input could be read; set --data or MRSNAKE_DATA to the shared data folder\n";
+      return 3;
+    }
   } catch (const std::exception& e) {
     std::cerr << "bench_remesh: " << e.what() << "\n";
     return 4;
