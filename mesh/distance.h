@@ -49,10 +49,13 @@ struct SurfaceDistance {
 };
 
 /// \pre both meshes have at least one face.
+/// \throw InputError if either mesh has no face.
 SurfaceDistance surface_distance(const TriMesh& mesh, const TriMesh& reference, const DistanceOptions& options = {});
 
 /// Number of pairs of faces that intersect (not counting neighbours that only share a
-/// vertex or an edge). 0 for a valid closed surface.
+/// vertex or an edge). 0 for a valid closed surface. Faces with a repeated corner are ignored.
+/// \throw TopologyError if a face makes the mesh non-manifold or inconsistently oriented
+///        (CGAL's halfedge mesh cannot hold it).
 int count_self_intersections(const TriMesh& mesh);
 
 void to_json(nlohmann::json& j, const SurfaceDistance& d);

@@ -1,0 +1,649 @@
+// bench_remesh: the project's remesher (`mrsnake remesh`, relaxed and --no-relax) against
+// CGAL's isotropic_remeshing on the same inputs, at the same face counts, measured in the
+// same run: time, peak memory, faces, regularity, triangle quality and distance to the input.
+//
+//   bench_remesh [--data DIR] [--mrsnake PATH] [--inputs a,b,...] [--targets 16000,32000]
+//                [--out DIR] [--samples N] [--iterations N] [--timeout SECONDS]
+//
+// mrsnake runs as a subprocess through its command-line contract
+//   mrsnake remesh INPUT -o DIR --faces N [--no-relax]  ->  DIR/level_0.vtp ... level_L.vtp, report.json
+// (wall time of the whole command and the child's peak RSS from wait4), and the level whose
+// face count is nearest N is measured. CGAL runs in this process (10 iterations, constraints
+// not protected) with a target edge length from the equilateral estimate, corrected once,
+// aimed at the face count of mrsnake's measured level (at N if mrsnake has none); its peak RSS is the process's high-water mark during the call (reset before it).
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/remesh.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/version.h>
+
+#include <fcntl.h>
+#include <malloc.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/time.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "mesh/atomic_file.h"
+#include "mesh/distance.h"
+#include "mesh/mesh_io.h"
+#include "mesh/quality.h"
+#include "mesh/topology.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+using namespace mrsnake;
+using Clock = std::chrono::steady_clock;
+
+// ---------------------------------------------------------------------------------------------
+// Options
+
+struct Options {
+  std::string data;
+  std::string mrsnake = MRSNAKE_DEFAULT_BIN;
+  std::vector<std::string> inputs = {"mushroom", "heart", "bear", "blobby", "retinal", "liver"};
+  std::vector<int> targets = {16000, 32000};
+  std::string out = "bench-remesh-out";
+  int samples = 10;
+  int iterations = 10;
+  double timeout = 1800;
+};
+
+std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> items;
+  std::stringstream ss(s);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) items.push_back(item);
+  return items;
+}
+
+int parse_count(std::string s) {
+  int scale = 1;
+  if (!s.empty() && (s.back() == 'k' || s.back() == 'K')) {
+    scale = 1000;
+    s.pop_back();
+  }
+  std::size_t used = 0;
+  const int value = std::stoi(s, &used);
+  if (used != s.size() || value <= 0) throw std::invalid_argument("not a positive count: " + s);
+  return value * scale;
+}
+
+[[noreturn]] void usage(const std::string& error) {
+  if (!error.empty()) std::cerr << "bench_remesh: " << error << "\n";
+  std::cerr << "usage: bench_remesh [--data DIR] [--mrsnake PATH] [--inputs mushroom,heart,...,liver]\n"
+               "                    [--targets 16000,32000] [--out DIR] [--samples N] [--iterations N]\n"
+               "                    [--timeout SECONDS]\n"
+               "  --data DIR        shared data folder (default $MRSNAKE_DATA, else ../shared/data)\n"
+               "  --mrsnake PATH    the mrsnake binary (default: the one built beside this benchmark)\n"
+               "  --inputs LIST     names under DIR/meshes (.off), 'liver' (from mrsnake mc), or mesh paths\n"
+               "  --targets LIST    face counts to aim at (16k accepted)\n"
+               "  --out DIR         working folder; bench_remesh.json is written there\n"
+               "  --samples N       random points per face for the surface distance (default 10)\n"
+               "  --iterations N    CGAL isotropic_remeshing iterations (default 10)\n"
+               "  --timeout S       per mrsnake run (default 1800)\n";
+  std::exit(error.empty() ? 0 : 2);
+}
+
+Options parse_options(int argc, char** argv) {
+  Options o;
+  if (const char* env = std::getenv("MRSNAKE_DATA"); env && *env) o.data = env;
+  else o.data = "../shared/data";
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) usage(arg + " needs a value");
+      return argv[++i];
+    };
+    try {
+      if (arg == "--data") o.data = value();
+      else if (arg == "--mrsnake") o.mrsnake = value();
+      else if (arg == "--inputs") o.inputs = split_list(value());
+      else if (arg == "--targets") {
+        o.targets.clear();
+        for (const auto& t : split_list(value())) o.targets.push_back(parse_count(t));
+      } else if (arg == "--out") o.out = value();
+      else if (arg == "--samples") o.samples = std::stoi(value());
+      else if (arg == "--iterations") o.iterations = std::stoi(value());
+      else if (arg == "--timeout") o.timeout = std::stod(value());
+      else if (arg == "-h" || arg == "--help") usage("");
+      else usage("unknown option " + arg);
+    } catch (const std::invalid_argument& e) {
+      usage(arg + ": " + e.what());
+    } catch (const std::out_of_range&) {
+      usage(arg + ": value out of range");
+    }
+  }
+  if (o.inputs.empty() || o.targets.empty()) usage("--inputs and --targets need at least one entry");
+  if (o.samples < 0 || o.iterations < 1 || o.timeout <= 0) usage("--samples, --iterations, --timeout must be positive");
+  return o;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Subprocesses and memory
+
+struct ChildRun {
+  int exit_code = -1;  ///< -1 if it did not exit normally (signal, timeout, exec failure)
+  bool timed_out = false;
+  double seconds = 0;
+  double cpu_seconds = 0;  ///< the child's user + system time (wait4)
+  double peak_mib = 0;     ///< the child's peak RSS (wait4)
+};
+
+double cpu_seconds_of(const struct rusage& u) {
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+/// User + system time of the calling thread so far.
+double thread_cpu_seconds() {
+  struct rusage u {};
+  getrusage(RUSAGE_THREAD, &u);
+  return cpu_seconds_of(u);
+}
+
+/// Runs a program with its output going to log_path; waits up to timeout seconds.
+ChildRun run_child(const std::vector<std::string>& args, const std::string& log_path, double timeout) {
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  ChildRun r;
+  const auto start = Clock::now();
+  const pid_t pid = fork();
+  if (pid < 0) return r;
+  if (pid == 0) {
+    const int fd = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) {
+      dup2(fd, STDOUT_FILENO);
+      dup2(fd, STDERR_FILENO);
+      ::close(fd);
+    }
+    execv(argv[0], argv.data());
+    std::fprintf(stderr, "cannot run %s\n", argv[0]);
+    _exit(127);
+  }
+  int status = 0;
+  struct rusage usage {};
+  for (;;) {
+    const pid_t done = wait4(pid, &status, WNOHANG, &usage);
+    if (done == pid) break;
+    if (done < 0) return r;
+    if (std::chrono::duration<double>(Clock::now() - start).count() > timeout) {
+      kill(pid, SIGKILL);
+      wait4(pid, &status, 0, &usage);
+      r.timed_out = true;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  r.cpu_seconds = cpu_seconds_of(usage);
+  r.peak_mib = static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+  if (!r.timed_out && WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
+  return r;
+}
+
+std::string last_line_of(const std::string& path) {
+  std::ifstream in(path);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (!line.empty()) last = line;
+  return last;
+}
+
+/// Resets this process's peak RSS (VmHWM) to its current RSS; false if the kernel refuses.
+bool reset_peak_rss() {
+  malloc_trim(0);  // hand freed heap back first, so the baseline is what is really in use
+  std::ofstream clear("/proc/self/clear_refs");
+  if (!clear) return false;
+  clear << "5";
+  clear.flush();
+  return static_cast<bool>(clear);
+}
+
+/// A field of /proc/self/status in MiB (VmHWM = peak RSS, VmRSS = current RSS).
+double proc_status_mib(const std::string& field) {
+  std::ifstream in("/proc/self/status");
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind(field + ":", 0) == 0) return std::stod(line.substr(field.size() + 1)) / 1024.0;  // kB
+  struct rusage usage {};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// CGAL's isotropic remeshing
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using SurfaceMesh = CGAL::Surface_mesh<Kernel::Point_3>;
+
+SurfaceMesh to_surface_mesh(const TriMesh& m) {
+  SurfaceMesh sm;
+  std::vector<SurfaceMesh::Vertex_index> vs;
+  vs.reserve(m.num_vertices());
+  for (int v = 0; v < m.num_vertices(); ++v) vs.push_back(sm.add_vertex({m.V(v, 0), m.V(v, 1), m.V(v, 2)}));
+  for (int f = 0; f < m.num_faces(); ++f)
+    if (sm.add_face(vs[m.F(f, 0)], vs[m.F(f, 1)], vs[m.F(f, 2)]) == SurfaceMesh::null_face())
+      throw std::runtime_error("face " + std::to_string(f) + " is non-manifold or misoriented for CGAL's Surface_mesh");
+  return sm;
+}
+
+TriMesh to_trimesh(const SurfaceMesh& sm) {
+  TriMesh m;
+  m.V.resize(sm.number_of_vertices(), 3);
+  std::vector<int> index(sm.num_vertices(), -1);  // num_vertices() counts removed slots too
+  int next = 0;
+  for (auto v : sm.vertices()) {
+    const auto& p = sm.point(v);
+    m.V.row(next) << p.x(), p.y(), p.z();
+    index[v.idx()] = next++;
+  }
+  m.F.resize(sm.number_of_faces(), 3);
+  int f = 0;
+  for (auto face : sm.faces()) {
+    int k = 0;
+    for (auto v : CGAL::vertices_around_face(sm.halfedge(face), sm)) {
+      if (k < 3) m.F(f, k) = index[v.idx()];
+      ++k;
+    }
+    if (k != 3) throw std::runtime_error("CGAL returned a non-triangle face");
+    ++f;
+  }
+  return m;
+}
+
+double total_area(const TriMesh& m) {
+  double a = 0;
+  for (int f = 0; f < m.num_faces(); ++f)
+    a += 0.5 * (m.V.row(m.F(f, 1)) - m.V.row(m.F(f, 0))).cross(m.V.row(m.F(f, 2)) - m.V.row(m.F(f, 0))).norm();
+  return a;
+}
+
+struct CgalRun {
+  TriMesh mesh;
+  double seconds = 0;     ///< the isotropic_remeshing call that produced `mesh`
+  double cpu_seconds = 0; ///< its user + system time
+  double peak_mib = 0;    ///< process peak RSS during that call
+  double rss_before_mib = 0;
+  double target_edge_length = 0;
+  double probe_edge_length = 0;
+  int probe_faces = 0;
+  double probe_seconds = 0;
+};
+
+CgalRun cgal_remesh_once(const TriMesh& input, double edge_length, int iterations) {
+  CgalRun r;
+  r.target_edge_length = edge_length;
+  const bool reset = reset_peak_rss();
+  r.rss_before_mib = proc_status_mib("VmRSS");
+  SurfaceMesh sm = to_surface_mesh(input);
+  const auto start = Clock::now();
+  const double cpu_start = thread_cpu_seconds();
+  CGAL::Polygon_mesh_processing::isotropic_remeshing(
+      faces(sm), edge_length, sm,
+      CGAL::parameters::number_of_iterations(static_cast<unsigned>(iterations)).protect_constraints(false));
+  r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  r.cpu_seconds = thread_cpu_seconds() - cpu_start;
+  sm.collect_garbage();
+  r.peak_mib = reset ? proc_status_mib("VmHWM") : std::nan("");
+  r.mesh = to_trimesh(sm);
+  return r;
+}
+
+/// Equilateral estimate: F faces of edge e cover F·(√3/4)e², so e = sqrt(4A/(√3·F)); one
+/// correction by the face count the first run gave (faces scale as 1/e²).
+CgalRun cgal_remesh(const TriMesh& input, int target_faces, int iterations) {
+  const double e0 = std::sqrt(4.0 * total_area(input) / (std::sqrt(3.0) * target_faces));
+  const CgalRun probe = cgal_remesh_once(input, e0, iterations);
+  const double e1 = e0 * std::sqrt(static_cast<double>(probe.mesh.num_faces()) / target_faces);
+  CgalRun r = cgal_remesh_once(input, e1, iterations);
+  r.probe_edge_length = e0;
+  r.probe_faces = probe.mesh.num_faces();
+  r.probe_seconds = probe.seconds;
+  return r;
+}
+
+// ---------------------------------------------------------------------------------------------
+// One row of the table
+
+struct Row {
+  std::string input, method;
+  int target = 0;
+  std::string status = "ok";  ///< "ok", or why there are no figures
+  int faces = 0, level = -1;
+  double seconds = 0, cpu_seconds = 0, peak_mib = 0;
+  std::optional<QualityReport> quality;
+  std::optional<SurfaceDistance> distance;
+  int self_intersections = -1;  ///< pairs of intersecting faces; -1 if not counted
+  double speed_ratio = std::nan("");  ///< CGAL's seconds / this row's seconds (> 1: faster than CGAL)
+  double cpu_speed_ratio = std::nan("");  ///< the same with user + system time
+  json extra = json::object();
+};
+
+void measure(Row& row, const TriMesh& output, const TriMesh& input, int samples) {
+  row.faces = output.num_faces();
+  row.quality = mesh_quality(output);
+  DistanceOptions options;
+  options.samples_per_face = samples;
+  row.distance = surface_distance(output, input, options);
+  try {
+    row.self_intersections = count_self_intersections(output);
+  } catch (const std::exception& e) {
+    row.extra["self_intersections_error"] = e.what();
+  }
+}
+
+/// The remesher's own time from report.json: its top-level "seconds", else the sum of the
+/// parameterization's and every level's "seconds" (under "per_level" or "levels").
+std::optional<double> internal_seconds(const json& report) {
+  if (report.contains("seconds") && report["seconds"].is_number()) return report["seconds"].get<double>();
+  double total = 0;
+  bool found = false;
+  if (report.contains("parameterization") && report["parameterization"].is_object() &&
+      report["parameterization"].contains("seconds") && report["parameterization"]["seconds"].is_number()) {
+    total += report["parameterization"]["seconds"].get<double>();
+    found = true;
+  }
+  for (const char* key : {"per_level", "levels"})
+    if (report.contains(key) && report[key].is_array())
+      for (const auto& level : report[key])
+        if (level.is_object() && level.contains("seconds") && level["seconds"].is_number()) {
+          total += level["seconds"].get<double>();
+          found = true;
+        }
+  if (!found) return std::nullopt;
+  return total;
+}
+
+Row run_mrsnake_remesh(const Options& o, const std::string& name, const std::string& input_path, const TriMesh& input,
+                       int target, bool relax, bool available) {
+  Row row;
+  row.input = name;
+  row.target = target;
+  row.method = relax ? "mrsnake" : "mrsnake-norelax";
+  if (!available) {
+    row.status = "mrsnake remesh unavailable";
+    return row;
+  }
+  const fs::path dir = fs::path(o.out) / name / (row.method + "-" + std::to_string(target));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::vector<std::string> args = {o.mrsnake, "-q", "remesh", input_path, "-o", dir.string(), "--faces",
+                                   std::to_string(target)};
+  if (!relax) args.push_back("--no-relax");
+  const std::string log = (dir / "mrsnake.log").string();
+  const ChildRun child = run_child(args, log, o.timeout);
+  row.seconds = child.seconds;
+  row.cpu_seconds = child.cpu_seconds;
+  row.peak_mib = child.peak_mib;
+  if (child.timed_out) {
+    row.status = "timed out after " + std::to_string(static_cast<int>(o.timeout)) + " s";
+    return row;
+  }
+  if (child.exit_code != 0) {
+    row.status = "exit " + std::to_string(child.exit_code) + ": " + last_line_of(log);
+    return row;
+  }
+  // The level nearest the target face count.
+  int best_faces = -1;
+  TriMesh best;
+  for (int level = 0;; ++level) {
+    const fs::path file = dir / ("level_" + std::to_string(level) + ".vtp");
+    if (!fs::exists(file)) break;
+    TriMesh m = read_mesh(file.string());
+    if (best_faces < 0 || std::abs(m.num_faces() - target) < std::abs(best_faces - target)) {
+      best_faces = m.num_faces();
+      best = std::move(m);
+      row.level = level;
+    }
+  }
+  if (best_faces < 0) {
+    row.status = "no level_0.vtp in " + dir.string();
+    return row;
+  }
+  measure(row, best, input, o.samples);
+  row.extra["levels_dir"] = dir.string();
+  const fs::path report_path = dir / "report.json";
+  if (fs::exists(report_path)) {
+    try {
+      std::ifstream in(report_path);
+      const json report = json::parse(in);
+      if (const auto s = internal_seconds(report)) row.extra["report_seconds"] = *s;
+    } catch (const std::exception& e) {
+      row.extra["report_error"] = e.what();
+    }
+  } else {
+    row.extra["report_error"] = "report.json missing";
+  }
+  return row;
+}
+
+/// CGAL aimed at `faces` (the face count mrsnake reached, so both are compared at the same
+/// size; the target N when mrsnake has no result). The row is still filed under `target`.
+Row run_cgal(const Options& o, const std::string& name, const TriMesh& input, int target, int faces) {
+  Row row;
+  row.input = name;
+  row.target = target;
+  row.method = "cgal-isotropic";
+  try {
+    const CgalRun r = cgal_remesh(input, faces, o.iterations);
+    row.seconds = r.seconds;
+    row.cpu_seconds = r.cpu_seconds;
+    row.peak_mib = r.peak_mib;
+    row.speed_ratio = row.cpu_speed_ratio = 1.0;
+    measure(row, r.mesh, input, o.samples);
+    row.extra.update(json{{"iterations", o.iterations},
+                          {"aimed_faces", faces},
+                 {"target_edge_length", r.target_edge_length},
+                 {"probe_edge_length", r.probe_edge_length},
+                 {"probe_faces", r.probe_faces},
+                 {"probe_seconds", r.probe_seconds},
+                 {"rss_before_mib", r.rss_before_mib}});
+    write_mesh((fs::path(o.out) / name / ("cgal-isotropic-" + std::to_string(target) + ".vtp")).string(), r.mesh);
+  } catch (const std::exception& e) {
+    row.status = std::string("failed: ") + e.what();
+  }
+  return row;
+}
+
+json row_json(const Row& r) {
+  json j = {{"input", r.input}, {"target_faces", r.target}, {"method", r.method}, {"status", r.status}};
+  if (r.status != "ok") return j;
+  j["faces"] = r.faces;
+  j["seconds"] = r.seconds;
+  j["cpu_seconds"] = r.cpu_seconds;
+  j["peak_mib"] = std::isnan(r.peak_mib) ? json(nullptr) : json(r.peak_mib);
+  if (r.level >= 0) j["level"] = r.level;
+  if (r.quality) j["quality"] = *r.quality;
+  if (r.distance) j["distance"] = *r.distance;
+  if (r.self_intersections >= 0) j["self_intersections"] = r.self_intersections;
+  j["speed_ratio_vs_cgal"] = std::isnan(r.speed_ratio) ? json(nullptr) : json(r.speed_ratio);
+  j["cpu_speed_ratio_vs_cgal"] = std::isnan(r.cpu_speed_ratio) ? json(nullptr) : json(r.cpu_speed_ratio);
+  for (const auto& [k, v] : r.extra.items()) j[k] = v;
+  return j;
+}
+
+void print_header() {
+  std::printf("%-9s %6s %-16s %7s %8s %7s %8s %7s %7s %6s %6s %7s %7s %5s %6s\n", "input", "target", "method", "faces",
+              "seconds", "cpu_s", "peakMiB", "val6%", "minang", "Qmin", "Qmean", "RMS%", "Haus%", "selfX", "speed");
+}
+
+void print_row(const Row& r) {
+  std::printf("%-9s %6d %-16s ", r.input.c_str(), r.target, r.method.c_str());
+  if (r.status != "ok") {
+    std::printf("%s\n", r.status.c_str());
+    return;
+  }
+  std::printf("%7d %8.2f %7.2f %8.1f %7.2f %7.2f %6.3f %6.3f %7.4f %7.4f ", r.faces, r.seconds, r.cpu_seconds, r.peak_mib,
+              r.quality->pct_valence6_interior, r.quality->min_angle_deg, r.quality->q_min, r.quality->q_mean,
+              r.distance->rms_pct, r.distance->hausdorff_pct);
+  if (r.self_intersections >= 0) std::printf("%5d ", r.self_intersections);
+  else std::printf("%5s ", "-");
+  if (std::isnan(r.speed_ratio)) std::printf("%6s\n", "-");
+  else std::printf("%6.2f\n", r.speed_ratio);
+}
+
+/// Whether `mrsnake --help` lists the subcommand (`mrsnake CMD --help` cannot tell: an
+/// unknown subcommand's --help still prints the main help and exits 0).
+bool has_command(const Options& o, const std::string& command) {
+  if (!fs::exists(o.mrsnake)) return false;
+  const std::string log = (fs::path(o.out) / "mrsnake-help.log").string();
+  if (run_child({o.mrsnake, "--help"}, log, 60).exit_code != 0) return false;
+  std::ifstream in(log);
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream words(line);
+    std::string first;
+    // Subcommands are listed one per line, indented, name first.
+    if (!line.empty() && line[0] == ' ' && words >> first && first == command) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Options o = parse_options(argc, argv);
+  try {
+    fs::create_directories(o.out);
+  } catch (const std::exception& e) {
+    std::cerr << "bench_remesh: cannot create the output folder " << o.out << ": " << e.what() << "\n";
+    return 4;
+  }
+  const bool remesh_available = has_command(o, "remesh");
+  if (!remesh_available)
+    std::cerr << "bench_remesh: '" << o.mrsnake
+              << " remesh' is unavailable (binary missing or no remesh command): only CGAL rows will have figures\n";
+
+  std::vector<Row> rows;
+  json inputs_json = json::array();
+  int inputs_read = 0;
+  // An input that cannot be read still gets its rows, saying why.
+  auto skip_input = [&](const std::string& name, const std::string& why) {
+    for (int t : o.targets)
+      for (const char* m : {"mrsnake", "mrsnake-norelax", "cgal-isotropic"}) {
+        Row r;
+        r.input = name;
+        r.target = t;
+        r.method = m;
+        r.status = why;
+        rows.push_back(r);
+      }
+  };
+  for (const std::string& name : o.inputs) {
+    // Resolve the input file.
+    std::string path;
+    std::string label = name;
+    if (name == "liver") {
+      path = (fs::path(o.out) / "liver.vtp").string();
+      const std::string labels = (fs::path(o.data) / "volumes" / "liver-labels.nii.gz").string();
+      std::cerr << "liver: mrsnake mc --labels " << labels << " --label 255 -o " << path << "\n";
+      const ChildRun mc = run_child({o.mrsnake, "-q", "mc", "--labels", labels, "--label", "255", "-o", path},
+                                    (fs::path(o.out) / "liver-mc.log").string(), o.timeout);
+      if (mc.exit_code != 0) {
+        const std::string why = "skipped: 'mrsnake mc' failed (" + last_line_of((fs::path(o.out) / "liver-mc.log").string()) + ")";
+        std::cerr << "liver: " << why << "\n";
+        skip_input("liver", why);
+        inputs_json.push_back({{"name", "liver"}, {"status", why}});
+        continue;
+      }
+    } else if (name.find('/') != std::string::npos || name.find('.') != std::string::npos) {
+      path = name;
+      label = fs::path(name).stem().string();
+    } else {
+      path = (fs::path(o.data) / "meshes" / (name + ".off")).string();
+    }
+    TriMesh input;
+    try {
+      input = read_mesh(path);
+    } catch (const std::exception& e) {
+      std::cerr << label << ": skipped: " << e.what() << "\n";
+      skip_input(label, std::string("skipped: ") + e.what());
+      inputs_json.push_back({{"name", label}, {"file", path}, {"status", std::string("skipped: ") + e.what()}});
+      continue;
+    }
+    ++inputs_read;
+    fs::create_directories(fs::path(o.out) / label);
+    const TopologyReport topo = topology_report(input);
+    inputs_json.push_back({{"name", label},
+                           {"file", path},
+                           {"status", "ok"},
+                           {"vertices", input.num_vertices()},
+                           {"faces", input.num_faces()},
+                           {"topology", topo.describe()},
+                           {"diagonal_mm", bounding_box_diagonal(input.V)}});
+    for (int target : o.targets) {
+      std::cerr << label << " " << target << ": mrsnake...\n";
+      Row relaxed = run_mrsnake_remesh(o, label, path, input, target, true, remesh_available);
+      std::cerr << label << " " << target << ": mrsnake --no-relax...\n";
+      Row plain = run_mrsnake_remesh(o, label, path, input, target, false, remesh_available);
+      const int aim = relaxed.status == "ok" ? relaxed.faces : target;
+      std::cerr << label << " " << target << ": cgal-isotropic (aiming at " << aim << " faces)...\n";
+      Row cgal = run_cgal(o, label, input, target, aim);
+      for (Row* r : {&relaxed, &plain})
+        if (r->status == "ok" && cgal.status == "ok" && r->seconds > 0) {
+          r->speed_ratio = cgal.seconds / r->seconds;
+          if (r->cpu_seconds > 0) r->cpu_speed_ratio = cgal.cpu_seconds / r->cpu_seconds;
+        }
+      rows.push_back(relaxed);
+      rows.push_back(plain);
+      rows.push_back(cgal);
+    }
+  }
+
+  std::printf("\nRemeshing benchmark: mrsnake remesh against CGAL isotropic_remeshing (%d iterations)\n",
+              o.iterations);
+  std::printf("mrsnake: wall time and peak RSS of the whole 'mrsnake remesh' command (subprocess);\n"
+              "CGAL: the isotropic_remeshing call in process, peak RSS of this process during it; its edge\n"
+              "length is tuned to the face count of mrsnake's level (else to the target).\n"
+              "val6%% = interior vertices of valence 6; RMS%%, Haus%% = symmetric distance to the input in %% of\n"
+              "its bounding-box diagonal (%d samples per face + vertices); selfX = pairs of intersecting faces;\n"
+              "cpu_s = user + system time;\n"
+              "speed = CGAL seconds / seconds (wall; > 1 is faster than CGAL; the JSON also has the CPU ratio).\n\n",
+              o.samples);
+  print_header();
+  for (const Row& r : rows) print_row(r);
+
+  json j = {{"benchmark", "remesh"},
+            {"mrsnake", o.mrsnake},
+            {"mrsnake_remesh_available", remesh_available},
+            {"cgal_version", CGAL_VERSION_STR},
+            {"cgal_iterations", o.iterations},
+            {"samples_per_face", o.samples},
+            {"hardware_threads", std::thread::hardware_concurrency()},
+            {"inputs", inputs_json},
+            {"rows", json::array()}};
+  for (const Row& r : rows) j["rows"].push_back(row_json(r));
+  const std::string json_path = (fs::path(o.out) / "bench_remesh.json").string();
+  try {
+    write_text_file_atomically(json_path, j.dump(2) + "\n");
+    std::printf("\nwrote %s\n", json_path.c_str());
+    if (inputs_read == 0) {
+      std::cerr << "bench_remesh: no input could be read; set --data or MRSNAKE_DATA to the shared data folder\n";
+      return 3;
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "bench_remesh: " << e.what() << "\n";
+    return 4;
+  }
+  return 0;
+}
