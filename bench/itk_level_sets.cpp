@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "mesh/itk_volume.h"
 #include "mesh/errors.h"
 #include "mesh/image_io.h"
 
@@ -30,32 +31,8 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-template <class Image>
-typename Image::Pointer allocate_like(const Volume& v) {
-  auto image = Image::New();
-  typename Image::RegionType region;
-  typename Image::SpacingType spacing;
-  typename Image::PointType origin;
-  typename Image::DirectionType direction;
-  for (int d = 0; d < 3; ++d) {
-    region.SetSize(d, v.size[d]);
-    spacing[d] = v.spacing[d];
-    origin[d] = v.origin[d];
-    for (int c = 0; c < 3; ++c) direction(d, c) = v.direction[3 * d + c];
-  }
-  image->SetRegions(region);
-  image->SetSpacing(spacing);
-  image->SetOrigin(origin);
-  image->SetDirection(direction);
-  image->Allocate();
-  return image;
-}
-
-FloatImage::Pointer to_itk(const Volume& v) {
-  auto image = allocate_like<FloatImage>(v);
-  std::copy(v.data.begin(), v.data.end(), image->GetBufferPointer());
-  return image;
-}
+using itk_volume::allocate_like;
+using itk_volume::to_itk;
 
 double median_of(std::vector<float> values) {
   if (values.empty()) return 0;

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <string>
 
+#include "mesh/itk_volume.h"
 #include "mesh/errors.h"
 
 namespace mrsnake {
@@ -22,32 +23,8 @@ using FloatImage = itk::Image<float, 3>;
 using MaskImage = itk::Image<unsigned char, 3>;
 using VectorImage = itk::Image<itk::Vector<float, 3>, 3>;
 
-template <class Image>
-typename Image::Pointer allocate_like(const Volume& v) {
-  auto image = Image::New();
-  typename Image::RegionType region;
-  typename Image::SpacingType spacing;
-  typename Image::PointType origin;
-  typename Image::DirectionType direction;
-  for (int d = 0; d < 3; ++d) {
-    region.SetSize(d, v.size[d]);
-    spacing[d] = v.spacing[d];
-    origin[d] = v.origin[d];
-    for (int c = 0; c < 3; ++c) direction(d, c) = v.direction[3 * d + c];
-  }
-  image->SetRegions(region);
-  image->SetSpacing(spacing);
-  image->SetOrigin(origin);
-  image->SetDirection(direction);
-  image->Allocate();
-  return image;
-}
-
-FloatImage::Pointer to_itk(const Volume& v) {
-  auto image = allocate_like<FloatImage>(v);
-  std::copy(v.data.begin(), v.data.end(), image->GetBufferPointer());
-  return image;
-}
+using itk_volume::allocate_like;
+using itk_volume::to_itk;
 
 Volume from_itk(const FloatImage* image, const Volume& like) {
   Volume out = like;
