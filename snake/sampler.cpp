@@ -35,53 +35,55 @@ inline void split(double x, long n, long& i0, long& i1, double& f) {
 }
 }  // namespace
 
-float VolumeSampler::value_at_index(const Eigen::Vector3d& idx) const {
-  long i0, i1, j0, j1, k0, k1;
+// The voxel cell around a continuous index, blended along x and y: what both the value
+// and its gradient are made of.
+namespace {
+struct TrilinearCell {
   double fx, fy, fz;
-  split(idx.x(), nx_, i0, i1, fx);
-  split(idx.y(), ny_, j0, j1, fy);
-  split(idx.z(), nz_, k0, k1, fz);
-  const float* d = volume_->data.data();
-  const long sy = nx_, sz = nx_ * ny_;
-  const double c000 = d[i0 + j0 * sy + k0 * sz], c100 = d[i1 + j0 * sy + k0 * sz];
-  const double c010 = d[i0 + j1 * sy + k0 * sz], c110 = d[i1 + j1 * sy + k0 * sz];
-  const double c001 = d[i0 + j0 * sy + k1 * sz], c101 = d[i1 + j0 * sy + k1 * sz];
-  const double c011 = d[i0 + j1 * sy + k1 * sz], c111 = d[i1 + j1 * sy + k1 * sz];
-  const double c00 = c000 + fx * (c100 - c000), c10 = c010 + fx * (c110 - c010);
-  const double c01 = c001 + fx * (c101 - c001), c11 = c011 + fx * (c111 - c011);
-  const double c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
-  return static_cast<float>(scale_ * (c0 + fz * (c1 - c0)) + offset_);
+  double c000, c100, c010, c110, c001, c101, c011, c111;  // corner values
+  double c00, c10, c01, c11, c0, c1;                       // blends along x, then y
+  double value() const { return c0 + fz * (c1 - c0); }
+};
+
+inline TrilinearCell trilinear_cell(const float* d, long nx, long ny, long nz, const Eigen::Vector3d& idx) {
+  TrilinearCell c;
+  long i0, i1, j0, j1, k0, k1;
+  split(idx.x(), nx, i0, i1, c.fx);
+  split(idx.y(), ny, j0, j1, c.fy);
+  split(idx.z(), nz, k0, k1, c.fz);
+  const long sy = nx, sz = nx * ny;
+  c.c000 = d[i0 + j0 * sy + k0 * sz], c.c100 = d[i1 + j0 * sy + k0 * sz];
+  c.c010 = d[i0 + j1 * sy + k0 * sz], c.c110 = d[i1 + j1 * sy + k0 * sz];
+  c.c001 = d[i0 + j0 * sy + k1 * sz], c.c101 = d[i1 + j0 * sy + k1 * sz];
+  c.c011 = d[i0 + j1 * sy + k1 * sz], c.c111 = d[i1 + j1 * sy + k1 * sz];
+  c.c00 = c.c000 + c.fx * (c.c100 - c.c000), c.c10 = c.c010 + c.fx * (c.c110 - c.c010);
+  c.c01 = c.c001 + c.fx * (c.c101 - c.c001), c.c11 = c.c011 + c.fx * (c.c111 - c.c011);
+  c.c0 = c.c00 + c.fy * (c.c10 - c.c00), c.c1 = c.c01 + c.fy * (c.c11 - c.c01);
+  return c;
+}
+}  // namespace
+
+float VolumeSampler::value_at_index(const Eigen::Vector3d& idx) const {
+  const TrilinearCell c = trilinear_cell(volume_->data.data(), nx_, ny_, nz_, idx);
+  return static_cast<float>(scale_ * c.value() + offset_);
 }
 
 float VolumeSampler::value_and_gradient(const Eigen::Vector3d& p, Eigen::Vector3d& gradient) const {
   const Eigen::Vector3d idx = to_index(p);
-  long i0, i1, j0, j1, k0, k1;
-  double fx, fy, fz;
-  split(idx.x(), nx_, i0, i1, fx);
-  split(idx.y(), ny_, j0, j1, fy);
-  split(idx.z(), nz_, k0, k1, fz);
-  const float* d = volume_->data.data();
-  const long sy = nx_, sz = nx_ * ny_;
-  const double c000 = d[i0 + j0 * sy + k0 * sz], c100 = d[i1 + j0 * sy + k0 * sz];
-  const double c010 = d[i0 + j1 * sy + k0 * sz], c110 = d[i1 + j1 * sy + k0 * sz];
-  const double c001 = d[i0 + j0 * sy + k1 * sz], c101 = d[i1 + j0 * sy + k1 * sz];
-  const double c011 = d[i0 + j1 * sy + k1 * sz], c111 = d[i1 + j1 * sy + k1 * sz];
-  const double c00 = c000 + fx * (c100 - c000), c10 = c010 + fx * (c110 - c010);
-  const double c01 = c001 + fx * (c101 - c001), c11 = c011 + fx * (c111 - c011);
-  const double c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
+  const TrilinearCell c = trilinear_cell(volume_->data.data(), nx_, ny_, nz_, idx);
   // Derivatives of the interpolant in index space; zero along an axis that is clamped
   // outside the image or has a single voxel.
   const auto inside_axis = [](double x, long n) { return n > 1 && x >= 0.0 && x <= static_cast<double>(n - 1); };
   Eigen::Vector3d g_idx;
   {
-    const double d0 = (c100 - c000) + fy * ((c110 - c010) - (c100 - c000));
-    const double d1 = (c101 - c001) + fy * ((c111 - c011) - (c101 - c001));
-    g_idx.x() = inside_axis(idx.x(), nx_) ? d0 + fz * (d1 - d0) : 0.0;
+    const double d0 = (c.c100 - c.c000) + c.fy * ((c.c110 - c.c010) - (c.c100 - c.c000));
+    const double d1 = (c.c101 - c.c001) + c.fy * ((c.c111 - c.c011) - (c.c101 - c.c001));
+    g_idx.x() = inside_axis(idx.x(), nx_) ? d0 + c.fz * (d1 - d0) : 0.0;
   }
-  g_idx.y() = inside_axis(idx.y(), ny_) ? (c10 - c00) + fz * ((c11 - c01) - (c10 - c00)) : 0.0;
-  g_idx.z() = inside_axis(idx.z(), nz_) ? c1 - c0 : 0.0;
+  g_idx.y() = inside_axis(idx.y(), ny_) ? (c.c10 - c.c00) + c.fz * ((c.c11 - c.c01) - (c.c10 - c.c00)) : 0.0;
+  g_idx.z() = inside_axis(idx.z(), nz_) ? c.c1 - c.c0 : 0.0;
   gradient = scale_ * (index_gradient_to_physical_ * g_idx);
-  return static_cast<float>(scale_ * (c0 + fz * (c1 - c0)) + offset_);
+  return static_cast<float>(scale_ * c.value() + offset_);
 }
 
 bool VolumeSampler::inside(const Eigen::Vector3d& p) const {
