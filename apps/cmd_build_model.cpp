@@ -26,6 +26,7 @@ void add_build_model_command(CLI::App& app) {
     std::string labels, output, predict = "butterfly", image;
     int label = 1, levels = 0, faces = 32768, smooth = 20, close_tunnels = 0;
     bool full_report = false, json = false, compare_unrelaxed = false;
+    double reference_margin_mm = 20.0;
   };
   auto a = std::make_shared<Args>();
   cmd->add_option("--labels", a->labels, "Label volume (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)")->required();
@@ -45,7 +46,12 @@ void add_build_model_command(CLI::App& app) {
       ->check(CLI::Range(0, 20));
   cmd->add_option("--image", a->image,
                   "Reference intensity image of the labels (same physical space): stores the appearance "
-                  "(profiles along the normals, inside/outside statistics) that 'mrsnake segment' matches");
+                  "(profiles along the normals, inside/outside statistics) that 'mrsnake segment' matches, and a "
+                  "crop of the image around the organ that 'mrsnake segment --init register' registers to a new image");
+  cmd->add_option("--reference-margin", a->reference_margin_mm,
+                  "Margin (mm) of the stored reference image crop around the organ (with --image)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 200.0));
   cmd->add_flag("--full-report", a->full_report, "Quality and distance to the input at every level (slower)");
   cmd->add_flag("--compare-unrelaxed", a->compare_unrelaxed,
                 "Also remesh without relaxation and compare both in MODEL/report.html (a second remeshing run)");
@@ -106,7 +112,11 @@ void add_build_model_command(CLI::App& app) {
 
     if (!a->image.empty()) {
       report(progress, "appearance", 0.0);
-      add_appearance(model, read_volume(a->image));
+      const Volume reference = read_volume(a->image);
+      add_appearance(model, reference);
+      ReferenceImageOptions ro;
+      ro.margin_mm = a->reference_margin_mm;
+      add_reference_image(model, reference, ro);
       lap("appearance");
     }
 

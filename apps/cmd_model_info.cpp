@@ -6,6 +6,7 @@
 
 #include "apps/cli.h"
 #include "mesh/errors.h"
+#include "snake/reference_image.h"
 #include "wavelets/model_io.h"
 
 namespace mrsnake::cli {
@@ -39,6 +40,10 @@ void add_model_info_command(CLI::App& app) {
     const double diag = bounding_box_diagonal(stored);
     const double max_err = err.maxCoeff(), rms_err = std::sqrt(err.squaredNorm() / err.size());
     const bool ok = max_err <= 1e-9 * diag;
+    // The reference image section, decoded (its own checksum and layout checked).
+    nlohmann::json reference = nullptr;
+    if (const auto it = model.sections.find(kReferenceImageSection); it != model.sections.end())
+      reference_image_to_json(reference, deserialize_reference_image(it->second));
     nlohmann::json synthesis = {{"level", model.levels()},
                                 {"max_error_mm", max_err},
                                 {"rms_error_mm", rms_err},
@@ -47,7 +52,7 @@ void add_model_info_command(CLI::App& app) {
                                 {"seconds", seconds},
                                 {"ok", ok}};
     if (*json) {
-      print_json({{"model", *model_path}, {"manifest", manifest}, {"synthesis", synthesis}});
+      print_json({{"model", *model_path}, {"manifest", manifest}, {"synthesis", synthesis}, {"reference_image", reference}});
     } else {
       std::cout << *model_path << ": mrsnake model, format version " << manifest["format_version"] << '\n';
       if (!model.source_image.empty() || model.source_label)
@@ -90,6 +95,16 @@ void add_model_info_command(CLI::App& app) {
         std::cout << "  sections         ";
         for (const auto& [name, blob] : model.sections) std::cout << ' ' << name << " (" << blob.size() << " bytes)";
         std::cout << '\n';
+      }
+      if (!reference.is_null()) {
+        const auto& sz = reference["size"];
+        const auto& sp = reference["spacing"];
+        const auto& ex = reference["extent_mm"];
+        std::cout << "  reference image   " << sz[0] << "x" << sz[1] << "x" << sz[2] << " voxels of "
+                  << format("%.3g", sp[0].get<double>()) << "x" << format("%.3g", sp[1].get<double>()) << "x"
+                  << format("%.3g", sp[2].get<double>()) << " mm (" << format("%.0f", ex[0].get<double>()) << "x"
+                  << format("%.0f", ex[1].get<double>()) << "x" << format("%.0f", ex[2].get<double>())
+                  << " mm), for segment --init register\n";
       }
       std::cout << "  synthesis of S_" << model.levels() << " from S_0 and the details: max error "
                 << format("%.3g", max_err) << " mm (" << format("%.3g", diag > 0 ? max_err / diag : 0.0)

@@ -22,7 +22,7 @@ namespace mrsnake::cli {
 void add_segment_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("segment", "Segment a volume with a shape model: coarse-to-fine snake, labels, surfaces and a report");
   struct Args {
-    std::string image, model, output, truth, init = "moments+fit", force = "auto";
+    std::string image, model, output, truth, init = "auto", force = "auto", register_metric = "mattes";
     int truth_label = 1, max_iterations = -1;
     bool json = false;
   };
@@ -31,7 +31,13 @@ void add_segment_command(CLI::App& app) {
   cmd->add_option("--model", a->model, "Shape model folder (made by 'mrsnake build-model')")->required();
   cmd->add_option("-o,--output", a->output, "Output folder: surface.vtp, labels.nii.gz, levels/level_j.vtp, report.json, report.html")
       ->required();
-  cmd->add_option("--init", a->init, "Initial pose: pose, moments, fit, moments+fit")->capture_default_str();
+  cmd->add_option("--init", a->init,
+                  "Initial pose: auto (register+fit if the model has a reference image, else moments+fit), pose, "
+                  "moments, fit, moments+fit, register, register+fit")
+      ->capture_default_str();
+  cmd->add_option("--register-metric", a->register_metric,
+                  "Metric of --init register: mattes (mutual information) or mean_squares (normalized intensities)")
+      ->capture_default_str();
   cmd->add_option("--force", a->force, "External force: auto (profiles if the model has an appearance), profile, edge")
       ->capture_default_str();
   cmd->add_option("--truth", a->truth, "Truth labels on the image's grid: adds the scores of 'mrsnake evaluate' to the report");
@@ -42,12 +48,16 @@ void add_segment_command(CLI::App& app) {
       "Example:\n"
       "  mrsnake segment --image case7/image.nii.gz --model heart.model -o case7/seg --truth case7/truth.nii.gz\n"
       "Writes DIR/surface.vtp (final level), DIR/labels.nii.gz (1 inside, on the image's grid),\n"
-      "DIR/levels/level_j.vtp (each level after deformation), DIR/report.json and DIR/report.html.");
+      "DIR/levels/level_j.vtp (each level after deformation), DIR/report.json and DIR/report.html.\n"
+      "With a model built by 'build-model --image', the default initialization registers the model's\n"
+      "reference image to IMAGE (ITK, similarity), then fits the coarse mesh; report.json's\n"
+      "'registration' holds the transform, the metric and whether it was used or why not.");
   cmd->callback([a] {
     const auto progress = terminal_progress();
     const auto t_load = std::chrono::steady_clock::now();
     SegmentOptions options;
     options.init = parse_init_mode(a->init);
+    options.registration.itk.metric = parse_registration_metric(a->register_metric);
     options.force = parse_force_mode(a->force);
     if (a->max_iterations >= 0) options.snake.max_iterations = a->max_iterations;
     report(progress, "load", 0.0);
@@ -61,6 +71,9 @@ void add_segment_command(CLI::App& app) {
     const double load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_load).count();
 
     const SegmentResult result = segment(image, model, options, progress);
+    if (result.registration && !result.registration->accepted)
+      warn("the reference image registration was not used (" + result.registration->rejection + "); initialized with " +
+           to_string(result.init) + " instead");
     report(progress, "rasterize", 0.0);
     const auto t_out = std::chrono::steady_clock::now();
     const Volume labels = rasterize_mesh(result.surface, image, 1.0f);

@@ -144,6 +144,28 @@ struct Case {
   int model_levels = 0;
 };
 
+/// One initialization route on one case: the Dice of its initial surface and of the result.
+struct InitRow {
+  std::string case_name, init, init_used;
+  double initial_dice = std::numeric_limits<double>::quiet_NaN();
+  double final_dice = std::numeric_limits<double>::quiet_NaN();
+  double init_seconds = std::numeric_limits<double>::quiet_NaN();      ///< register + initialize stages
+  double register_seconds = std::numeric_limits<double>::quiet_NaN();  ///< the registration alone
+  std::string registration;  ///< "accepted", "rejected: why", or "" when not asked for
+};
+
+/// The initialization columns of a segment report.
+void fill_init_row(InitRow& row, const json& rep) {
+  row.init_used = rep.value("init_used", std::string());
+  const json& st = rep["stage_seconds"];
+  row.init_seconds = st.value("initialize", 0.0) + st.value("register", 0.0);
+  if (st.contains("register")) row.register_seconds = st["register"].get<double>();
+  if (rep.contains("registration")) {
+    const json& g = rep["registration"];
+    row.registration = g["accepted"].get<bool>() ? "accepted" : "rejected: " + g.value("rejection", std::string());
+  }
+}
+
 struct Bench {
   std::string mrsnake;
   fs::path work;
@@ -154,6 +176,7 @@ struct Bench {
   std::string only;  ///< run only the cases whose name contains this
   bench::LevelSetOptions itk_options;
   std::vector<Row> rows;
+  std::vector<InitRow> init_rows;
   json cases = json::array();
 
   ChildResult mrsnake_cmd(const std::vector<std::string>& args, const fs::path& dir, const std::string& tag,
@@ -260,6 +283,15 @@ struct Bench {
     init_row.scores = score_in_child(init / "labels.nii.gz", c.truth, c.dir / "score-init.json");
     rows.push_back(init_row);
     rows.push_back(snake);
+    {
+      InitRow ir;
+      ir.case_name = c.name;
+      ir.init = primary_init.empty() ? "(default)" : primary_init;
+      fill_init_row(ir, init_report);
+      ir.initial_dice = init_row.scores.dice;
+      ir.final_dice = snake.scores.dice;
+      init_rows.push_back(ir);
+    }
 
     // Other initializations of the snake, for comparison (the level sets keep the default's start).
     for (const std::string& mode : extra_inits) {
@@ -281,8 +313,24 @@ struct Bench {
         row.wall_seconds = rx.wall_seconds;
         row.scores = score_in_child(dir / "labels.nii.gz", c.truth, c.dir / ("score-init-" + mode + ".json"));
         row.extra = {{"initial_pose", rep["initial_pose"]}, {"stage_seconds", rep["stage_seconds"]}};
+        if (rep.contains("registration")) row.extra["registration"] = rep["registration"];
       }
       rows.push_back(row);
+      // Its initial surface (no iteration), for the initialization table.
+      InitRow ir;
+      ir.case_name = c.name;
+      ir.init = mode;
+      ir.final_dice = row.scores.dice;
+      const fs::path start_dir = c.dir / ("init-" + mode);
+      const ChildResult rs = mrsnake_cmd({"segment", "--image", c.image.string(), "--model", c.model.string(), "-o",
+                                          start_dir.string(), "--init", mode, "--max-iterations", "0", "--json"},
+                                         c.dir, "init-" + mode, false);
+      if (rs.exit_code == 0) {
+        fill_init_row(ir, json::parse(read_text(start_dir / "report.json")));
+        ir.initial_dice =
+            score_in_child(start_dir / "labels.nii.gz", c.truth, c.dir / ("score-start-" + mode + ".json")).dice;
+      }
+      init_rows.push_back(ir);
     }
 
     Row best;
@@ -363,6 +411,25 @@ struct Bench {
                   num(r.scores.hd95_mm, "%.3f").c_str(), num(r.seconds, "%.3f").c_str(),
                   num(r.load_seconds, "%.3f").c_str(), num(r.peak_mib, "%.0f").c_str(),
                   std::isnan(r.speedup) ? "" : num(r.speedup, "%.1f×").c_str());
+    if (init_rows.empty()) return;
+    std::printf("\nInitialization routes (initial surface: the same run with --max-iterations 0):\n\n"
+                "| case | --init | route taken | initial Dice | final Dice | init s | registration s | registration |\n"
+                "|---|---|---|---|---|---|---|---|\n");
+    for (const InitRow& r : init_rows)
+      std::printf("| %s | %s | %s | %s | %s | %s | %s | %s |\n", r.case_name.c_str(), r.init.c_str(), r.init_used.c_str(),
+                  num(r.initial_dice, "%.4f").c_str(), num(r.final_dice, "%.4f").c_str(), num(r.init_seconds, "%.3f").c_str(),
+                  num(r.register_seconds, "%.3f").c_str(), r.registration.c_str());
+  }
+
+  json init_rows_json() const {
+    json out = json::array();
+    const auto val = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+    for (const InitRow& r : init_rows)
+      out.push_back({{"case", r.case_name}, {"init", r.init}, {"init_used", r.init_used},
+                     {"initial_dice", val(r.initial_dice)}, {"final_dice", val(r.final_dice)},
+                     {"init_seconds", val(r.init_seconds)}, {"register_seconds", val(r.register_seconds)},
+                     {"registration", r.registration}});
+    return out;
   }
 
   /// Targets per case: Dice ≥ best ITK, speed-up ≥ 20, and (256³) compute ≤ 1 s with ≥ 5 levels.
@@ -590,7 +657,7 @@ int main(int argc, char** argv) {
       // The model's own pose + the similarity fit: the moments of a threshold mislead on these
       // images (neighbouring tissue of similar intensity); the default is shown for comparison.
       b.primary_init = "fit";
-      b.extra_inits = {"moments+fit"};
+      b.extra_inits = {"moments+fit", "register", "register+fit"};
       real_cases(b, real);
     }
   } catch (const std::exception& e) {
@@ -606,6 +673,7 @@ int main(int argc, char** argv) {
            {"model_appearance", b.model_takes_image},
            {"threads", 1},
            {"rows", b.to_json_rows()},
+           {"initializations", b.init_rows_json()},
            {"targets", targets},
            {"total_seconds", seconds_since(t0)}};
   write_text_file_atomically(json_out, out.dump(2) + "\n");

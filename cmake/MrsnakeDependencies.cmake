@@ -14,7 +14,8 @@ find_package(ITK 5.2 REQUIRED COMPONENTS
   ITKCommon ITKIOImageBase ITKIONIFTI ITKIONRRD ITKIOMeta ITKIOGIPL ITKIOGDCM
   ITKImageIntensity ITKImageFilterBase ITKThresholding ITKSmoothing ITKImageGrid
   ITKBinaryMathematicalMorphology ITKLabelMap ITKDistanceMap ITKLevelSets ITKImageGradient ITKRegistrationCommon ITKTransform
-  ITKImageFunction ITKStatistics ITKOptimizers ITKImageCompare)
+  ITKImageFunction ITKStatistics ITKOptimizers ITKImageCompare
+  ITKOptimizersv4 ITKMetricsv4 ITKRegistrationMethodsv4)
 find_package(CLI11 CONFIG QUIET)
 find_package(nlohmann_json 3.10 REQUIRED)
 find_package(Threads REQUIRED)

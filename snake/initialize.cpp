@@ -3,12 +3,14 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <numeric>
 #include <vector>
 
 #include "mesh/errors.h"
+#include "snake/appearance.h"
 #include "snake/rasterize.h"
 #include "snake/sampler.h"
 
@@ -256,6 +258,53 @@ Similarity fit_similarity_to_targets(RowMatrixX3d& V, const RowMatrixX3i& F, con
   }
   if (iterations_done) *iterations_done = it;
   return total;
+}
+
+ReferenceRegistration register_reference(const Volume& reference, const std::vector<const Volume*>& pyramid,
+                                         double level0_scale, double level0_offset,
+                                         const ReferenceRegistrationOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  ReferenceRegistration out;
+  std::vector<double> spacings;
+  for (const Volume* v : pyramid) spacings.push_back(std::max({v->spacing[0], v->spacing[1], v->spacing[2]}));
+  const double ref_spacing = std::max({reference.spacing[0], reference.spacing[1], reference.spacing[2]});
+  out.pyramid_level = pyramid_level_for_edge(ref_spacing, spacings, 1.0);
+  RegistrationOptions ro = options.itk;
+  if (out.pyramid_level == 0) {
+    ro.moving_intensity_scale = level0_scale;
+    ro.moving_intensity_offset = level0_offset;
+  }
+  try {
+    out.result = register_similarity(reference, *pyramid[out.pyramid_level], ro);
+    out.ran = true;
+  } catch (const Error& e) {  // no overlap, or ITK gave up: the caller falls back
+    out.rejection = e.what();
+  }
+  if (out.ran) {
+    const RegistrationTransform& t = out.result.transform;
+    bool finite = std::isfinite(out.result.final_metric) && std::isfinite(t.scale);
+    for (double m : t.matrix) finite = finite && std::isfinite(m);
+    for (double m : t.offset) finite = finite && std::isfinite(m);
+    if (!finite) {
+      out.rejection = "the registration diverged (non-finite result)";
+    } else if (!(out.result.final_metric < out.result.initial_metric)) {
+      out.rejection = "the registration did not improve the metric (" + std::to_string(out.result.initial_metric) +
+                      " at the start, " + std::to_string(out.result.final_metric) + " at the end)";
+    } else if (t.scale < options.min_scale || t.scale > options.max_scale) {
+      out.rejection = "the registration's scale " + std::to_string(t.scale) + " is outside [" +
+                      std::to_string(options.min_scale) + ", " + std::to_string(options.max_scale) + "]";
+    } else {
+      out.accepted = true;
+      Eigen::Matrix3d A;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) A(r, c) = t.matrix[3 * r + c];
+      out.pose.scale = t.scale;
+      out.pose.rotation = A / t.scale;
+      out.pose.translation = Eigen::Vector3d(t.offset[0], t.offset[1], t.offset[2]);
+    }
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
 }
 
 }  // namespace mrsnake

@@ -4,10 +4,13 @@
 /// threshold, then (optionally) a fit of the whole coarse mesh to its own search targets,
 /// which does most of the work on real images.
 #include <limits>
+#include <string>
+#include <vector>
 
 #include "mesh/trimesh.h"
 #include "mesh/volume.h"
 #include "snake/deformable_surface.h"
+#include "snake/registration_itk.h"
 
 namespace mrsnake {
 
@@ -86,5 +89,31 @@ struct TargetFitOptions {
 /// Returns the total similarity; V is updated.
 Similarity fit_similarity_to_targets(RowMatrixX3d& V, const RowMatrixX3i& F, const ExternalSearch& search,
                                      const TargetFitOptions& options = {}, int* iterations_done = nullptr);
+
+struct ReferenceRegistrationOptions {
+  RegistrationOptions itk;
+  double min_scale = 0.5, max_scale = 2.0;  ///< a scale outside this range is a failure
+};
+
+/// The outcome of placing the model by registering its reference image to the new one.
+struct ReferenceRegistration {
+  bool ran = false;           ///< ITK's registration ran to its end
+  bool accepted = false;      ///< its pose is used
+  std::string rejection;      ///< why not (empty when accepted)
+  Similarity pose;            ///< reference space → new image (the identity when rejected)
+  RegistrationResult result;  ///< ITK's outcome (when it ran)
+  int pyramid_level = 0;      ///< the level of the new image's pyramid registered to
+  double seconds = 0;
+};
+
+/// Registers the model's reference image (FIXED) to the new image (MOVING), on the level of
+/// its pyramid whose voxel size is closest to the reference's, and judges the result: it is
+/// rejected, with the reason, if ITK fails, if the metric at the result is not better than
+/// at the start, or if the scale leaves [min_scale, max_scale].
+/// `level0_scale`, `level0_offset` normalize pyramid[0] when it holds raw intensities.
+/// \pre pyramid is not empty.
+ReferenceRegistration register_reference(const Volume& reference, const std::vector<const Volume*>& pyramid,
+                                         double level0_scale, double level0_offset,
+                                         const ReferenceRegistrationOptions& options = {});
 
 }  // namespace mrsnake

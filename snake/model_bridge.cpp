@@ -33,6 +33,8 @@ SnakeModel snake_model_from(const ShapeModel& model) {
   }
   if (const auto it = model.sections.find(kAppearanceSection); it != model.sections.end())
     m.appearance = deserialize_appearance(it->second);
+  if (const auto it = model.sections.find(kReferenceImageSection); it != model.sections.end())
+    m.reference_image = deserialize_reference_image(it->second);
   return m;
 }
 
@@ -43,6 +45,15 @@ void add_appearance(ShapeModel& model, const Volume& reference_image, const Appe
   const SubdivisionConnectivity conn = model.connectivity();
   const Appearance a = build_appearance(build_pyramid(normalized, 8), levels, conn.faces, options);
   model.sections[kAppearanceSection] = serialize_appearance(a);
+}
+
+void add_reference_image(ShapeModel& model, const Volume& reference_image, const ReferenceImageOptions& options) {
+  const std::vector<RowMatrixX3d> levels = model_levels(model);
+  // The whole image's window, as segment normalizes a new image.
+  const IntensityWindow window = robust_intensity_window(reference_image);
+  Volume crop = make_reference_crop(reference_image, levels.back(), options);
+  apply_intensity_window(crop, window);
+  model.sections[kReferenceImageSection] = serialize_reference_image(crop);
 }
 
 }  // namespace mrsnake

@@ -5,6 +5,7 @@
 /// section ("appearance") that build-model --image adds.
 #include "mesh/volume.h"
 #include "snake/appearance.h"
+#include "snake/reference_image.h"
 #include "snake/segment.h"
 #include "wavelets/model.h"
 
@@ -15,13 +16,19 @@ constexpr const char* kAppearanceSection = "appearance";
 
 /// The SnakeModel of a wavelet shape model: levels S_0..S_L (level_positions, or synthesized
 /// when not loaded), synthesis by WaveletTransform::synthesize_level with the model's
-/// details, and the appearance if the model has the section.
-/// \throw InputError if the model has no levels or a damaged appearance section.
+/// details, the appearance and the reference image if the model has their sections.
+/// \throw InputError if the model has no levels or a damaged appearance or reference image section.
 SnakeModel snake_model_from(const ShapeModel& model);
 
 /// Learns the appearance of every level from the reference image (in which the model's
 /// levels lie, in physical coordinates) and stores it in the model's "appearance" section.
 /// \throw InputError if the image is constant.
 void add_appearance(ShapeModel& model, const Volume& reference_image, const AppearanceOptions& options = {});
+
+/// Stores the robustly normalized crop of the reference image around the model's finest
+/// level (snake/reference_image.h) in the model's "reference_image" section, for
+/// `segment --init register`.
+/// \throw InputError if the image is constant or does not hold the model.
+void add_reference_image(ShapeModel& model, const Volume& reference_image, const ReferenceImageOptions& options = {});
 
 }  // namespace mrsnake

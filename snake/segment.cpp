@@ -77,15 +77,21 @@ SnakeModel midpoint_frame_model(const SubdivisionConnectivity& conn, const RowMa
 }
 
 InitMode parse_init_mode(const std::string& name) {
+  if (name == "auto") return InitMode::automatic;
+  if (name == "register") return InitMode::registration;
+  if (name == "register+fit") return InitMode::registration_and_fit;
   if (name == "pose") return InitMode::pose;
   if (name == "moments") return InitMode::moments;
   if (name == "moments+fit") return InitMode::moments_and_fit;
   if (name == "fit") return InitMode::fit;
-  throw InputError("unknown initialization '" + name + "'; use pose, moments, moments+fit or fit");
+  throw InputError("unknown initialization '" + name + "'; use auto, pose, moments, moments+fit, fit, register or register+fit");
 }
 
 std::string to_string(InitMode mode) {
   switch (mode) {
+    case InitMode::automatic: return "auto";
+    case InitMode::registration: return "register";
+    case InitMode::registration_and_fit: return "register+fit";
     case InitMode::pose: return "pose";
     case InitMode::moments: return "moments";
     case InitMode::moments_and_fit: return "moments+fit";
@@ -207,7 +213,26 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   report(progress, "initialize", 0.0);
   RowMatrixX3d V = model.levels[0];
   Similarity pose;
-  if (options.init == InitMode::moments || options.init == InitMode::moments_and_fit) {
+  InitMode init = options.init;
+  if (init == InitMode::automatic)
+    init = model.reference_image ? InitMode::registration_and_fit : InitMode::moments_and_fit;
+  if (init == InitMode::registration || init == InitMode::registration_and_fit) {
+    // Register the model's reference image to this one; on failure, the moments route.
+    if (!model.reference_image)
+      throw InputError("--init " + to_string(init) + " needs a model with a reference image (build-model --image)");
+    report(progress, "register", 0.0);
+    result.registration = register_reference(*model.reference_image, pyramid, level0_raw ? norm_scale : 1.0,
+                                             level0_raw ? norm_offset : 0.0, options.registration);
+    end_stage("register");
+    if (result.registration->accepted) {
+      pose = result.registration->pose;
+      V = pose.apply(V);
+    } else
+      init = init == InitMode::registration ? InitMode::moments : InitMode::moments_and_fit;
+  }
+  const bool registered = result.registration && result.registration->accepted;
+  result.init = init;
+  if (init == InitMode::moments || init == InitMode::moments_and_fit) {
     // Moments on a coarse level (noise averaged out), of a mid-resolution model level.
     const int p = std::min<int>(2, static_cast<int>(pyramid.size()) - 1);
     const int jm = std::min(L, 2);
@@ -224,7 +249,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   // Start hypotheses for the fit: the pose found, and the same without its rotation about
   // the centroid (principal axes can mislead on elongated or curved shapes).
   std::vector<Similarity> starts{pose};
-  if (pose.rotation_angle_deg() > 1.0) {
+  if (!registered && pose.rotation_angle_deg() > 1.0) {
     const Eigen::Vector3d c = model.levels[0].colwise().mean().transpose();
     Similarity unrotated = pose;
     unrotated.rotation.setIdentity();
@@ -251,7 +276,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   } else {
     stats = estimate_stats(V);
   }
-  if (options.init == InitMode::moments_and_fit || options.init == InitMode::fit) {
+  if (init == InitMode::moments_and_fit || init == InitMode::fit || init == InitMode::registration_and_fit) {
     // Fit the whole mesh of a level with enough vertices to carry the shape; synthesis
     // follows a similarity, so the pose found there applies to S_0 as well.
     const int jf = std::min(L, options.fit_level);
@@ -333,6 +358,36 @@ nlohmann::json segment_report(const SegmentResult& r) {
                        {"translation_mm", {r.initial_pose.translation.x(), r.initial_pose.translation.y(),
                                            r.initial_pose.translation.z()}},
                        {"fit_iterations", r.fit_iterations}};
+  j["init_used"] = to_string(r.init);
+  if (r.registration) {
+    const ReferenceRegistration& g = *r.registration;
+    nlohmann::json reg{{"accepted", g.accepted},
+                       {"ran", g.ran},
+                       {"seconds", g.seconds},
+                       {"pyramid_level", g.pyramid_level}};
+    if (!g.accepted) {
+      reg["rejection"] = g.rejection;
+      reg["fallback"] = to_string(r.init);
+    }
+    if (g.ran) {
+      const RegistrationResult& x = g.result;
+      reg["metric"] = x.metric;
+      reg["initial_metric"] = x.initial_metric;
+      reg["final_metric"] = x.final_metric;
+      reg["valid_points"] = {x.valid_points_initial, x.valid_points_final};
+      reg["iterations_per_level"] = x.iterations;
+      reg["stop_condition"] = x.stop_condition;
+      reg["moving_crop_size"] = x.moving_crop_size;
+      reg["transform"] = {{"scale", x.transform.scale},
+                          {"rotation_deg", x.transform.angle_deg},
+                          {"versor_xyzw", x.transform.versor},
+                          {"centre_mm", x.transform.centre},
+                          {"translation_mm", x.transform.translation},
+                          {"matrix", x.transform.matrix},
+                          {"offset_mm", x.transform.offset}};
+    }
+    j["registration"] = reg;
+  }
   nlohmann::json levels = nlohmann::json::array();
   bool all_converged = true;
   for (const LevelOutcome& l : r.levels) {

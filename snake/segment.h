@@ -29,6 +29,8 @@ struct SnakeModel {
   /// S_{j+1} from a (deformed) S_j, j = 0..L−1, with the model's stored details.
   std::function<RowMatrixX3d(int j, const RowMatrixX3d& coarse)> synthesize;
   std::optional<Appearance> appearance;
+  /// The normalized crop of the reference image (snake/reference_image.h), if stored.
+  std::optional<Volume> reference_image;
 
   int finest_level() const { return connectivity.levels(); }
   const RowMatrixX3i& faces(int j) const { return connectivity.faces[j]; }
@@ -43,12 +45,15 @@ struct SnakeModel {
 SnakeModel midpoint_frame_model(const SubdivisionConnectivity& conn, const RowMatrixX3d& finest);
 
 enum class InitMode {
-  pose,             ///< the model's physical pose as is
-  moments,          ///< + moments of a rough threshold
-  moments_and_fit,  ///< + a similarity fit of the coarse mesh to its search targets (default)
-  fit,              ///< the model's pose + the fit
+  automatic,             ///< register+fit when the model has a reference image, else moments+fit (default)
+  pose,                  ///< the model's physical pose as is
+  moments,               ///< + moments of a rough threshold
+  moments_and_fit,       ///< + a similarity fit of the coarse mesh to its search targets
+  fit,                   ///< the model's pose + the fit
+  registration,          ///< + registration of the model's reference image to the image
+  registration_and_fit,  ///< + the registration, then the fit
 };
-/// \throw InputError for an unknown name (pose, moments, moments+fit, fit).
+/// \throw InputError for an unknown name (auto, pose, moments, moments+fit, fit, register, register+fit).
 InitMode parse_init_mode(const std::string& name);
 std::string to_string(InitMode mode);
 
@@ -59,7 +64,10 @@ std::string to_string(ForceMode mode);
 
 struct SegmentOptions {
   SnakeOptions snake;
-  InitMode init = InitMode::moments_and_fit;
+  InitMode init = InitMode::automatic;
+  /// The registration routes; when the registration is rejected they fall back to the
+  /// moments routes (register → moments, register+fit → moments+fit).
+  ReferenceRegistrationOptions registration;
   ForceMode force = ForceMode::automatic;  ///< automatic: profile when the model has an appearance
   TargetFitOptions fit;
   int fit_level = 2;  ///< the mesh level whose vertices the similarity fit uses (capped at L)
@@ -93,6 +101,8 @@ struct SegmentResult {
   TriMesh surface;             ///< the final level
   std::vector<LevelOutcome> levels;
   Similarity initial_pose;     ///< applied to the model's S_0 before the coarse-to-fine run
+  InitMode init = InitMode::pose;  ///< the route taken (auto resolved, after any fallback)
+  std::optional<ReferenceRegistration> registration;  ///< when a registration route was asked for
   int fit_iterations = 0;
   RegionStats region;
   IntensityWindow window;

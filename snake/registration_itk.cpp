@@ -1,0 +1,349 @@
+// ITK translation unit: no Eigen and no CGAL here (ITK bundles its own Eigen).
+#include "snake/registration_itk.h"
+
+#include <itkCommand.h>
+#include <itkImageRegistrationMethodv4.h>
+#include <itkMattesMutualInformationImageToImageMetricv4.h>
+#include <itkMeanSquaresImageToImageMetricv4.h>
+#include <itkPointSet.h>
+#include <itkRegularStepGradientDescentOptimizerv4.h>
+#include <itkSimilarity3DTransform.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "mesh/errors.h"
+#include "mesh/itk_volume.h"
+
+namespace mrsnake {
+namespace {
+
+using FloatImage = itk_volume::FloatImage;
+using Transform = itk::Similarity3DTransform<double>;
+using Optimizer = itk::RegularStepGradientDescentOptimizerv4<double>;
+using MetricBase = itk::ImageToImageMetricv4<FloatImage, FloatImage>;
+using MattesMetric = itk::MattesMutualInformationImageToImageMetricv4<FloatImage, FloatImage>;
+using MeanSquaresMetric = itk::MeanSquaresImageToImageMetricv4<FloatImage, FloatImage>;
+using Registration = itk::ImageRegistrationMethodv4<FloatImage, FloatImage, Transform>;
+using Clock = std::chrono::steady_clock;
+
+MetricBase::Pointer make_metric(const RegistrationOptions& o) {
+  if (o.metric == RegistrationMetric::mattes) {
+    auto m = MattesMetric::New();
+    m->SetNumberOfHistogramBins(static_cast<itk::SizeValueType>(std::max(8, o.histogram_bins)));
+    m->SetUseMovingImageGradientFilter(false);  // gradients by central differences where sampled
+    m->SetUseFixedImageGradientFilter(false);
+    return m.GetPointer();
+  }
+  auto m = MeanSquaresMetric::New();
+  m->SetUseMovingImageGradientFilter(false);
+  m->SetUseFixedImageGradientFilter(false);
+  return m.GetPointer();
+}
+
+// Stops the optimizer once the time budget is spent (checked every iteration).
+class TimeGuard : public itk::Command {
+ public:
+  using Self = TimeGuard;
+  using Pointer = itk::SmartPointer<Self>;
+  itkNewMacro(Self);
+  Optimizer* optimizer = nullptr;
+  Clock::time_point start;
+  double max_seconds = 1.0;
+  int iterations = 0;
+  bool timed_out = false;
+  void Execute(itk::Object* caller, const itk::EventObject& event) override { Execute(static_cast<const itk::Object*>(caller), event); }
+  void Execute(const itk::Object*, const itk::EventObject& event) override {
+    if (!itk::IterationEvent().CheckEvent(&event)) return;
+    ++iterations;
+    if (std::chrono::duration<double>(Clock::now() - start).count() > max_seconds) {
+      timed_out = true;
+      optimizer->StopOptimization();
+    }
+  }
+};
+
+// A regular grid of about `count` physical points of the fixed image (voxel centres).
+MetricBase::FixedSampledPointSetType::Pointer grid_points(const Volume& fixed, int count) {
+  auto points = MetricBase::FixedSampledPointSetType::New();
+  const double voxels = static_cast<double>(fixed.num_voxels());
+  const int stride = std::max(1, static_cast<int>(std::floor(std::cbrt(voxels / std::max(1, count)))));
+  itk::IdentifierType id = 0;
+  for (std::size_t k = stride / 2; k < fixed.size[2]; k += stride)
+    for (std::size_t j = stride / 2; j < fixed.size[1]; j += stride)
+      for (std::size_t i = stride / 2; i < fixed.size[0]; i += stride) {
+        const auto p = fixed.index_to_physical(static_cast<double>(i), static_cast<double>(j), static_cast<double>(k));
+        MetricBase::FixedSampledPointSetType::PointType q;
+        for (int a = 0; a < 3; ++a) q[a] = p[a];
+        points->SetPoint(id++, q);
+      }
+  return points;
+}
+
+// The metric at a transform, on a fixed grid of samples of the full-resolution images.
+double evaluate_metric(const RegistrationOptions& o, FloatImage* fixed, FloatImage* moving, const Transform* at,
+                       MetricBase::FixedSampledPointSetType* points, int* valid) {
+  auto metric = make_metric(o);
+  auto t = Transform::New();
+  t->SetFixedParameters(at->GetFixedParameters());
+  t->SetParameters(at->GetParameters());
+  metric->SetFixedImage(fixed);
+  metric->SetMovingImage(moving);
+  metric->SetMovingTransform(t);
+  metric->SetFixedSampledPointSet(points);
+  metric->SetUseSampledPointSet(true);
+  metric->SetMaximumNumberOfWorkUnits(static_cast<itk::ThreadIdType>(std::max(1, o.threads)));
+  metric->Initialize();
+  const double value = metric->GetValue();
+  *valid = static_cast<int>(metric->GetNumberOfValidPoints());
+  return value;
+}
+
+// The radius at which the fixed image's edges lie about `centre`: the RMS distance of the
+// strongest tenth of the gradient magnitudes (central differences, every other voxel), so
+// that noise spread over the whole crop does not count. Rotations and scalings move those
+// edges by about this radius times the angle (the scale change), so it sets the parameter
+// scales that make all steps comparable in millimetres.
+double edge_radius(const Volume& v, const std::array<double, 3>& centre) {
+  std::vector<std::pair<double, double>> samples;  // squared gradient, squared distance
+  for (std::size_t k = 1; k + 1 < v.size[2]; k += 2)
+    for (std::size_t j = 1; j + 1 < v.size[1]; j += 2)
+      for (std::size_t i = 1; i + 1 < v.size[0]; i += 2) {
+        const double gx = (v.at(i + 1, j, k) - v.at(i - 1, j, k)) / (2 * v.spacing[0]);
+        const double gy = (v.at(i, j + 1, k) - v.at(i, j - 1, k)) / (2 * v.spacing[1]);
+        const double gz = (v.at(i, j, k + 1) - v.at(i, j, k - 1)) / (2 * v.spacing[2]);
+        const auto p = v.index_to_physical(static_cast<double>(i), static_cast<double>(j), static_cast<double>(k));
+        const double r2 = (p[0] - centre[0]) * (p[0] - centre[0]) + (p[1] - centre[1]) * (p[1] - centre[1]) +
+                          (p[2] - centre[2]) * (p[2] - centre[2]);
+        samples.emplace_back(gx * gx + gy * gy + gz * gz, r2);
+      }
+  const double min_radius = 2.0 * std::max({v.spacing[0], v.spacing[1], v.spacing[2]});
+  if (samples.empty()) return min_radius;
+  const std::size_t top = std::max<std::size_t>(1, samples.size() / 10);
+  std::nth_element(samples.begin(), samples.begin() + static_cast<long>(top), samples.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  double sum = 0;
+  for (std::size_t s = 0; s < top; ++s) sum += samples[s].second;
+  return std::max(min_radius, std::sqrt(sum / static_cast<double>(top)));
+}
+
+RegistrationTransform to_plain(const Transform* t) {
+  RegistrationTransform r;
+  const auto M = t->GetMatrix();
+  const auto off = t->GetOffset();
+  const auto c = t->GetCenter();
+  const auto tr = t->GetTranslation();
+  for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < 3; ++b) r.matrix[3 * a + b] = M(a, b);
+    r.offset[a] = off[a];
+    r.centre[a] = c[a];
+    r.translation[a] = tr[a];
+  }
+  const auto v = t->GetVersor();
+  r.versor = {v.GetX(), v.GetY(), v.GetZ(), v.GetW()};
+  r.scale = t->GetScale();
+  r.angle_deg = v.GetAngle() * 180.0 / M_PI;
+  if (r.angle_deg > 180.0) r.angle_deg = 360.0 - r.angle_deg;
+  return r;
+}
+
+}  // namespace
+
+RegistrationMetric parse_registration_metric(const std::string& name) {
+  if (name == "mattes") return RegistrationMetric::mattes;
+  if (name == "mean_squares") return RegistrationMetric::mean_squares;
+  throw InputError("unknown registration metric '" + name + "'; use mattes or mean_squares");
+}
+
+std::string to_string(RegistrationMetric metric) {
+  return metric == RegistrationMetric::mattes ? "mattes" : "mean_squares";
+}
+
+std::array<double, 3> RegistrationTransform::apply(const std::array<double, 3>& x) const {
+  std::array<double, 3> y{};
+  for (int a = 0; a < 3; ++a)
+    y[a] = matrix[3 * a] * x[0] + matrix[3 * a + 1] * x[1] + matrix[3 * a + 2] * x[2] + offset[a];
+  return y;
+}
+
+bool index_box_of_points(const Volume& image, const std::vector<std::array<double, 3>>& points, double margin_fraction,
+                         double margin_mm, std::array<long, 3>& lo, std::array<long, 3>& hi) {
+  std::array<double, 3> mn{}, mx{};
+  mn.fill(std::numeric_limits<double>::max());
+  mx.fill(std::numeric_limits<double>::lowest());
+  for (const auto& p : points) {
+    const auto idx = image.physical_to_index(p);
+    for (int a = 0; a < 3; ++a) {
+      mn[a] = std::min(mn[a], idx[a]);
+      mx[a] = std::max(mx[a], idx[a]);
+    }
+  }
+  for (int a = 0; a < 3; ++a) {
+    const double grow = margin_fraction * (mx[a] - mn[a]) + margin_mm / image.spacing[a];
+    const long last = static_cast<long>(image.size[a]) - 1;
+    const double l = std::floor(mn[a] - grow), h = std::ceil(mx[a] + grow);
+    if (h < 0 || l > last) return false;
+    lo[a] = std::clamp(static_cast<long>(l), 0L, last);
+    hi[a] = std::clamp(static_cast<long>(h), 0L, last);
+  }
+  return true;
+}
+
+Volume crop_volume(const Volume& image, const std::array<long, 3>& lo, const std::array<long, 3>& hi) {
+  Volume out;
+  for (int a = 0; a < 3; ++a) out.size[a] = static_cast<std::size_t>(hi[a] - lo[a] + 1);
+  out.spacing = image.spacing;
+  out.direction = image.direction;
+  out.origin = image.index_to_physical(static_cast<double>(lo[0]), static_cast<double>(lo[1]), static_cast<double>(lo[2]));
+  out.data.resize(out.num_voxels());
+  std::size_t n = 0;
+  for (long k = lo[2]; k <= hi[2]; ++k)
+    for (long j = lo[1]; j <= hi[1]; ++j) {
+      const float* row = &image.data[image.index(static_cast<std::size_t>(lo[0]), static_cast<std::size_t>(j),
+                                                 static_cast<std::size_t>(k))];
+      std::copy(row, row + out.size[0], out.data.begin() + static_cast<long>(n));
+      n += out.size[0];
+    }
+  return out;
+}
+
+RegistrationResult register_similarity(const Volume& fixed, const Volume& moving, const RegistrationOptions& o) {
+  const auto t0 = Clock::now();
+  if (fixed.data.size() != fixed.num_voxels() || moving.data.size() != moving.num_voxels())
+    throw Error("internal: image buffer does not match its size");
+  for (int a = 0; a < 3; ++a)
+    if (fixed.size[a] < 8) throw InputError("the reference image is too small to register (fewer than 8 voxels along an axis)");
+  const std::size_t levels = o.shrink_factors.size();
+  if (levels == 0 || o.smoothing_voxels.size() != levels)
+    throw InputError("registration: give one smoothing value per shrink factor");
+
+  // The centre of the fixed image: the rotation and the scale act about it.
+  const auto centre = fixed.index_to_physical(0.5 * (fixed.size[0] - 1.0), 0.5 * (fixed.size[1] - 1.0), 0.5 * (fixed.size[2] - 1.0));
+  // The part of the moving image the fixed image can reach from the (identity) start.
+  std::vector<std::array<double, 3>> corners;
+  for (int c = 0; c < 8; ++c)
+    corners.push_back(fixed.index_to_physical((c & 1) ? fixed.size[0] - 1.0 : 0.0, (c & 2) ? fixed.size[1] - 1.0 : 0.0,
+                                              (c & 4) ? fixed.size[2] - 1.0 : 0.0));
+  std::array<long, 3> lo{}, hi{};
+  if (!index_box_of_points(moving, corners, o.moving_margin_fraction, o.moving_margin_mm, lo, hi))
+    throw InputError("the model's reference image does not overlap the image; use another --init");
+  for (int a = 0; a < 3; ++a)
+    if (hi[a] - lo[a] < 3) throw InputError("the model's reference image barely overlaps the image; use another --init");
+  Volume moving_crop = crop_volume(moving, lo, hi);
+  if (o.moving_intensity_scale != 1.0 || o.moving_intensity_offset != 0.0)
+    for (float& v : moving_crop.data)
+      v = static_cast<float>(o.moving_intensity_scale * v + o.moving_intensity_offset);
+
+  RegistrationResult result;
+  result.moving_crop_size = moving_crop.size;
+  result.metric = to_string(o.metric);
+  const auto fixed_image = itk_volume::to_itk(fixed);
+  const auto moving_image = itk_volume::to_itk(moving_crop);
+
+  auto transform = Transform::New();
+  Transform::InputPointType c;
+  for (int a = 0; a < 3; ++a) c[a] = centre[a];
+  transform->SetCenter(c);
+  transform->SetIdentity();
+  transform->SetCenter(c);
+
+  const auto eval_points = grid_points(fixed, 16000);
+  try {
+    result.initial_metric =
+        evaluate_metric(o, fixed_image, moving_image, transform, eval_points, &result.valid_points_initial);
+
+    auto metric = make_metric(o);
+    auto optimizer = Optimizer::New();
+    optimizer->SetLearningRate(o.initial_step_mm);
+    optimizer->SetMinimumStepLength(o.min_step_mm);
+    optimizer->SetRelaxationFactor(o.relaxation);
+    optimizer->SetNumberOfIterations(static_cast<itk::SizeValueType>(std::max(1, o.iterations_per_level)));
+    optimizer->SetReturnBestParametersAndValue(true);
+    optimizer->SetNumberOfWorkUnits(static_cast<itk::ThreadIdType>(std::max(1, o.threads)));
+    optimizer->SetGradientMagnitudeTolerance(1e-12);
+    // Parameter scales from physical shifts at the edges' radius: versor components and
+    // scale move edges by radius × change, translations by the change (regular step descent
+    // divides the gradient by the scales, so each step is then about learning-rate mm).
+    const double radius = o.rotation_radius_mm > 0 ? o.rotation_radius_mm : edge_radius(fixed, centre);
+    result.edge_radius_mm = radius;
+    Optimizer::ScalesType scales(transform->GetNumberOfParameters());
+    for (unsigned p = 0; p < scales.Size(); ++p) scales[p] = (p < 3 || p == 6) ? radius * radius : 1.0;
+    optimizer->SetScales(scales);
+
+    auto registration = Registration::New();
+    registration->SetFixedImage(fixed_image);
+    registration->SetMovingImage(moving_image);
+    registration->SetMetric(metric);
+    registration->SetOptimizer(optimizer);
+    registration->SetInitialTransform(transform);
+    registration->InPlaceOn();
+    registration->SetNumberOfWorkUnits(static_cast<itk::ThreadIdType>(std::max(1, o.threads)));
+    registration->SetNumberOfLevels(static_cast<itk::SizeValueType>(levels));
+    Registration::ShrinkFactorsArrayType shrink(levels);
+    Registration::SmoothingSigmasArrayType sigmas(levels);
+    Registration::MetricSamplingPercentageArrayType percentages(levels);
+    for (std::size_t l = 0; l < levels; ++l) {
+      const int f = std::max(1, o.shrink_factors[l]);
+      shrink[l] = static_cast<itk::SizeValueType>(f);
+      sigmas[l] = o.smoothing_voxels[l];
+      const double voxels = static_cast<double>(fixed.num_voxels()) / (static_cast<double>(f) * f * f);
+      percentages[l] = std::clamp(o.samples_per_level / voxels, 0.01, 1.0);
+    }
+    registration->SetShrinkFactorsPerLevel(shrink);
+    registration->SetSmoothingSigmasPerLevel(sigmas);
+    registration->SmoothingSigmasAreSpecifiedInPhysicalUnitsOff();
+    registration->SetMetricSamplingStrategy(Registration::MetricSamplingStrategyType::REGULAR);
+    registration->SetMetricSamplingPercentagePerLevel(percentages);
+    registration->MetricSamplingReinitializeSeed(20261122);
+
+    auto guard = TimeGuard::New();
+    guard->optimizer = optimizer;
+    guard->start = t0;
+    guard->max_seconds = o.max_seconds;
+    optimizer->AddObserver(itk::IterationEvent(), guard);
+    // Iterations per level: the optimizer restarts its count at each level.
+    struct LevelCounter : public itk::Command {
+      using Pointer = itk::SmartPointer<LevelCounter>;
+      itkNewMacro(LevelCounter);
+      TimeGuard* guard = nullptr;
+      Optimizer* optimizer = nullptr;
+      std::vector<int>* per_level = nullptr;
+      double first_step = 1, step_factor = 1;
+      int at_start = 0;
+      void Execute(itk::Object* caller, const itk::EventObject& event) override { Execute(static_cast<const itk::Object*>(caller), event); }
+      void Execute(const itk::Object*, const itk::EventObject&) override {
+        if (!per_level->empty()) per_level->back() = guard->iterations - at_start;
+        at_start = guard->iterations;
+        // Each finer level starts from the coarser one's result: shorter first steps.
+        optimizer->SetLearningRate(first_step * std::pow(step_factor, static_cast<double>(per_level->size())));
+        per_level->push_back(0);
+      }
+    };
+    auto counter = LevelCounter::New();
+    counter->guard = guard;
+    counter->optimizer = optimizer;
+    counter->first_step = o.initial_step_mm;
+    counter->step_factor = o.step_factor_per_level;
+    counter->per_level = &result.iterations;
+    registration->AddObserver(itk::MultiResolutionIterationEvent(), counter);
+    registration->Update();
+    if (!result.iterations.empty()) result.iterations.back() = guard->iterations - counter->at_start;
+    result.stop_condition = guard->timed_out ? "time budget spent" : optimizer->GetStopConditionDescription();
+
+    const Transform* final_transform = registration->GetTransformOutput()->Get();
+    result.transform = to_plain(final_transform);
+    result.final_metric =
+        evaluate_metric(o, fixed_image, moving_image, final_transform, eval_points, &result.valid_points_final);
+  } catch (const itk::ExceptionObject& e) {
+    throw AlgorithmError(std::string("image registration failed: ") + e.GetDescription());
+  }
+  result.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return result;
+}
+
+}  // namespace mrsnake

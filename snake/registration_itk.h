@@ -1,0 +1,104 @@
+#pragma once
+/// \file registration_itk.h
+/// Image-to-image similarity registration with ITK's v4 framework, behind plain types: the
+/// implementation is an ITK translation unit (ITK bundles its own Eigen), so this header
+/// exposes nothing but mesh/volume.h and std types.
+///
+/// The result maps FIXED physical points to MOVING physical points (ITK's convention): with
+/// the model's reference image as FIXED and the new image as MOVING, it carries the model's
+/// vertices (which lie in the reference image's physical space) into the new image.
+#include <array>
+#include <string>
+#include <vector>
+
+#include "mesh/volume.h"
+
+namespace mrsnake {
+
+enum class RegistrationMetric {
+  mattes,        ///< Mattes mutual information (any monotone intensity mapping)
+  mean_squares,  ///< mean squared difference (same modality, normalized intensities)
+};
+/// \throw InputError for another name than "mattes" or "mean_squares".
+RegistrationMetric parse_registration_metric(const std::string& name);
+std::string to_string(RegistrationMetric metric);
+
+struct RegistrationOptions {
+  RegistrationMetric metric = RegistrationMetric::mattes;
+  int histogram_bins = 32;                     ///< Mattes only
+  /// Coarse to fine: shrink factors of the FIXED image per level, with the Gaussian
+  /// smoothing (in fixed voxels) applied before shrinking.
+  std::vector<int> shrink_factors{4, 2, 1};
+  std::vector<double> smoothing_voxels{2.0, 1.0, 0.0};
+  /// Metric samples per iteration and level (at most the voxels of that level), drawn on a
+  /// regular grid with a random jitter from a fixed seed: results are reproducible.
+  int samples_per_level = 6000;
+  int iterations_per_level = 60;
+  double initial_step_mm = 3.0;                ///< the optimizer's first step (regular step descent)
+  /// Radius at which rotations and scalings are measured against translations (parameter
+  /// scales); <= 0: the RMS distance of the fixed image's edges from its centre.
+  double rotation_radius_mm = 0;
+  double step_factor_per_level = 0.5;          ///< first step of level l: initial_step_mm · factor^l
+  double min_step_mm = 0.01;                   ///< stop when the step falls below this
+  double relaxation = 0.6;                     ///< step factor when the gradient turns back
+  /// The part of the MOVING image used: the fixed image's box mapped by the start
+  /// transform, grown by this fraction of its size per side plus margin_mm.
+  double moving_margin_fraction = 0.25;
+  double moving_margin_mm = 10.0;
+  /// A linear map applied to the moving image's intensities (e.g. its normalization, so
+  /// that mean squares compares like with like).
+  double moving_intensity_scale = 1.0, moving_intensity_offset = 0.0;
+  double max_seconds = 1.0;                    ///< stop the optimizer past this time (a guard)
+  int threads = 1;                             ///< ITK work units (1: one thread)
+};
+
+/// x ↦ matrix·x + offset, with matrix = scale·R (R a rotation), in physical space; also in
+/// ITK's centred form x ↦ scale·R·(x − centre) + centre + translation.
+struct RegistrationTransform {
+  std::array<double, 9> matrix{1, 0, 0, 0, 1, 0, 0, 0, 1};  ///< row-major, scale included
+  std::array<double, 3> offset{0, 0, 0};
+  std::array<double, 3> centre{0, 0, 0};
+  std::array<double, 3> translation{0, 0, 0};
+  std::array<double, 4> versor{0, 0, 0, 1};  ///< x, y, z, w of R
+  double scale = 1.0;
+  double angle_deg = 0.0;                     ///< rotation angle of R
+
+  std::array<double, 3> apply(const std::array<double, 3>& x) const;
+};
+
+struct RegistrationResult {
+  RegistrationTransform transform;
+  std::string metric;         ///< to_string of the metric used
+  double initial_metric = 0;  ///< at the start transform, on the full-resolution images
+  double final_metric = 0;    ///< the same evaluation at the result (lower is better)
+  int valid_points_initial = 0, valid_points_final = 0;  ///< of the evaluation samples
+  std::vector<int> iterations;                ///< per level
+  std::string stop_condition;                 ///< the optimizer's, at the last level
+  std::array<std::size_t, 3> moving_crop_size{0, 0, 0};
+  double edge_radius_mm = 0;                  ///< the radius the parameter scales used
+  double seconds = 0;                         ///< everything, crop and evaluations included
+};
+
+/// Registers `fixed` to `moving` with a Similarity3DTransform (versor, translation, scale)
+/// about the centre of the fixed image, starting from the identity: a multi-resolution
+/// ImageRegistrationMethodv4 with the chosen metric and regular step gradient descent
+/// (parameter scales from physical shifts). The moving image is first cropped to where the
+/// fixed image can land. Nothing is judged here: the caller compares initial and final
+/// metrics and the scale.
+/// \pre both volumes have data of their size; the fixed image has at least 8 voxels per axis.
+/// \throw InputError if the fixed image is too small or does not overlap the moving image.
+/// \throw AlgorithmError if ITK fails (e.g. too few samples land in the moving image).
+RegistrationResult register_similarity(const Volume& fixed, const Volume& moving, const RegistrationOptions& options = {});
+
+/// The box of `image` (voxel indices, inclusive) covering the physical points, grown by
+/// margin_fraction of its size per side plus margin_mm, clamped to the image. Returns false
+/// if the box misses the image entirely.
+bool index_box_of_points(const Volume& image, const std::vector<std::array<double, 3>>& points, double margin_fraction,
+                         double margin_mm, std::array<long, 3>& lo, std::array<long, 3>& hi);
+
+/// The voxels [lo, hi] (inclusive) of `image` as a volume of their own, in the same
+/// physical place.
+/// \pre 0 <= lo <= hi < size on each axis.
+Volume crop_volume(const Volume& image, const std::array<long, 3>& lo, const std::array<long, 3>& hi);
+
+}  // namespace mrsnake

@@ -1,0 +1,338 @@
+// The registration route of the initialization: ITK's similarity registration of the
+// model's reference image recovers a known pose, its guards reject what it must, the
+// reference image section survives the model round trip and a damaged one is refused, and
+// `segment --init register` reaches the end-to-end bound.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include <nlohmann/json.hpp>
+
+#include "mesh/errors.h"
+#include "snake/image_pyramid.h"
+#include "snake/initialize.h"
+#include "snake/model_bridge.h"
+#include "snake/reference_image.h"
+#include "snake/registration_itk.h"
+#include "snake/synth.h"
+#include "tests/test_support.h"
+#include "tests/wavelets/hierarchies.h"
+#include "wavelets/model_io.h"
+
+using namespace mrsnake;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A known similarity T(x) = c + t + s·R·(x − c) about the image centre.
+SimilarityParams known_pose(const Eigen::Vector3d& centre) {
+  SimilarityParams p;
+  p.centre = centre;
+  p.rotation = Eigen::AngleAxisd(10.0 * M_PI / 180.0, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  p.scale = 1.06;
+  p.translation = Eigen::Vector3d(3.2, -2.5, 1.7);
+  return p;
+}
+
+struct PosedPair {
+  SynthResult reference, target;
+  SimilarityParams pose;
+};
+
+// One blob rendered twice: in its own frame (the reference) and moved by a known pose.
+PosedPair posed_pair(SynthShape shape, int size, double snr) {
+  SynthOptions o;
+  o.shape = shape;
+  o.size = {size, size, size};
+  o.snr = snr;
+  o.seed = 5;
+  SynthParams params = draw_synth_params(o);
+  PosedPair pair;
+  pair.reference = render_synth(params);
+  pair.pose = known_pose(params.pose.centre);
+  params.pose = pair.pose;
+  params.options.seed = 6;  // other noise
+  pair.target = render_synth(params);
+  return pair;
+}
+
+// The crop that build-model --image stores (model_bridge.cpp's add_reference_image).
+Volume reference_crop(const Volume& image, const RowMatrixX3d& V) {
+  const IntensityWindow window = robust_intensity_window(image);
+  Volume crop = make_reference_crop(image, V);
+  apply_intensity_window(crop, window);
+  return crop;
+}
+
+std::vector<const Volume*> pointers(const std::vector<Volume>& pyramid) {
+  std::vector<const Volume*> p;
+  for (const Volume& v : pyramid) p.push_back(&v);
+  return p;
+}
+
+Eigen::Vector3d apply_pose(const SimilarityParams& p, const Eigen::Vector3d& x) {
+  return p.centre + p.translation + p.scale * (p.rotation * (x - p.centre));
+}
+
+std::vector<std::uint8_t> read_all(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void write_all(const fs::path& p, const std::vector<std::uint8_t>& b) {
+  std::ofstream out(p, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+}
+
+}  // namespace
+
+struct PoseErrors {
+  double angle_deg = 0, scale = 0, centre_mm = 0, surface_mean_mm = 0, surface_max_mm = 0;
+};
+
+// Registers the reference crop of `pair` to its posed target and measures the errors
+// against the known pose on the reference's truth surface.
+PoseErrors register_and_measure(const PosedPair& pair, const char* name) {
+  const Volume crop = reference_crop(pair.reference.image, pair.reference.truth_mesh.V);
+  Volume normalized = pair.target.image;
+  normalize_intensities(normalized);
+  const std::vector<Volume> pyramid = build_pyramid(normalized, 4);
+  const ReferenceRegistration r = register_reference(crop, pointers(pyramid), 1.0, 0.0);
+  PoseErrors e;
+  EXPECT_TRUE(r.ran) << r.rejection;
+  EXPECT_TRUE(r.accepted) << r.rejection;
+  if (!r.accepted) return {1e9, 1e9, 1e9, 1e9, 1e9};
+  EXPECT_LT(r.result.final_metric, r.result.initial_metric);
+  e.angle_deg = Eigen::AngleAxisd(r.pose.rotation.transpose() * pair.pose.rotation).angle() * 180.0 / M_PI;
+  e.scale = std::abs(r.pose.scale / pair.pose.scale - 1.0);
+  const RowMatrixX3d& V = pair.reference.truth_mesh.V;
+  for (int v = 0; v < V.rows(); ++v) {
+    const Eigen::Vector3d x = V.row(v).transpose();
+    const double d = (r.pose.apply(x) - apply_pose(pair.pose, x)).norm();
+    e.surface_mean_mm += d / V.rows();
+    e.surface_max_mm = std::max(e.surface_max_mm, d);
+  }
+  const Eigen::Vector3d c = V.colwise().mean().transpose();
+  e.centre_mm = (r.pose.apply(c) - apply_pose(pair.pose, c)).norm();
+  std::printf("%s: registration %.3f s on pyramid level %d, metric %.4f -> %.4f, iterations", name, r.seconds,
+              r.pyramid_level, r.result.initial_metric, r.result.final_metric);
+  for (int it : r.result.iterations) std::printf(" %d", it);
+  std::printf(", edge radius %.1f mm (%s)\n  rotation error %.3f deg, scale error %.3f%%, centre error %.3f mm, "
+              "surface error mean %.3f max %.3f mm\n",
+              r.result.edge_radius_mm, r.result.stop_condition.c_str(), e.angle_deg, 100 * e.scale, e.centre_mm,
+              e.surface_mean_mm, e.surface_max_mm);
+  return e;
+}
+
+TEST(Registration, RecoversAKnownSimilarity) {
+  // An ellipsoid with three distinct axes: its pose is fully determined by the image
+  // (1 mm voxels; pose: 10 deg, scale 1.06, shift 4.4 mm).
+  const PoseErrors e = register_and_measure(posed_pair(SynthShape::ellipsoid, 64, 8.0), "ellipsoid");
+  EXPECT_LT(e.angle_deg, 2.0);
+  EXPECT_LT(e.scale, 0.02);
+  EXPECT_LT(e.centre_mm, 1.0);
+  EXPECT_LT(e.surface_mean_mm, 1.0);
+}
+
+TEST(Registration, PlacesTheSurfaceOfABlobWithinAVoxel) {
+  // A blob is nearly round, so its rotation is weakly determined; what counts is where
+  // its surface lands.
+  const PoseErrors e = register_and_measure(posed_pair(SynthShape::blob, 64, 8.0), "blob");
+  EXPECT_LT(e.centre_mm, 1.0);
+  EXPECT_LT(e.surface_mean_mm, 1.0);
+  EXPECT_LT(e.scale, 0.02);
+}
+
+TEST(Registration, RejectsAScaleOutsideItsRangeAndAnImageElsewhere) {
+  const PosedPair pair = posed_pair(SynthShape::blob, 48, 8.0);
+  const Volume crop = reference_crop(pair.reference.image, pair.reference.truth_mesh.V);
+  Volume normalized = pair.target.image;
+  normalize_intensities(normalized);
+  const std::vector<Volume> pyramid = build_pyramid(normalized, 4);
+  ReferenceRegistrationOptions narrow;
+  narrow.min_scale = 0.5;
+  narrow.max_scale = 1.03;  // the true scale is 1.06
+  const ReferenceRegistration r = register_reference(crop, pointers(pyramid), 1.0, 0.0, narrow);
+  EXPECT_TRUE(r.ran);
+  EXPECT_FALSE(r.accepted);
+  EXPECT_NE(r.rejection.find("scale"), std::string::npos) << r.rejection;
+  EXPECT_TRUE(r.pose.rotation.isIdentity() && r.pose.scale == 1.0 && r.pose.translation.isZero());
+
+  // An image far from the reference: no overlap, a rejection with its reason, no throw.
+  std::vector<Volume> far = pyramid;
+  for (Volume& v : far) v.origin[0] += 1000.0;
+  const ReferenceRegistration f = register_reference(crop, pointers(far), 1.0, 0.0);
+  EXPECT_FALSE(f.ran);
+  EXPECT_FALSE(f.accepted);
+  EXPECT_NE(f.rejection.find("overlap"), std::string::npos) << f.rejection;
+}
+
+TEST(Registration, CropKeepsThePhysicalPlaceAndAverages) {
+  // A linear ramp along x: block averages of a linear function equal its value at the
+  // block centre, so the crop must read the ramp at its own voxel centres.
+  Volume image;
+  image.size = {200, 40, 30};
+  image.spacing = {0.5, 1.0, 2.0};
+  image.origin = {-7, 3, 11};
+  image.data.resize(image.num_voxels());
+  for (std::size_t k = 0; k < image.size[2]; ++k)
+    for (std::size_t j = 0; j < image.size[1]; ++j)
+      for (std::size_t i = 0; i < image.size[0]; ++i) {
+        const auto p = image.index_to_physical(double(i), double(j), double(k));
+        image.at(i, j, k) = static_cast<float>(2.0 * p[0] - p[1] + 0.5 * p[2]);
+      }
+  RowMatrixX3d V(2, 3);
+  V << 10, 10, 20, 60, 30, 50;
+  ReferenceImageOptions o;
+  o.margin_mm = 5;
+  o.max_voxels_per_axis = 40;
+  const Volume crop = make_reference_crop(image, V, o);
+  // x: [5, 65] mm at 0.5 mm = 121 voxels → factor 4 → 30 voxels of 2 mm.
+  EXPECT_EQ(crop.size[0], 30u);
+  EXPECT_DOUBLE_EQ(crop.spacing[0], 2.0);
+  for (int a = 0; a < 3; ++a) EXPECT_LE(crop.size[a], 40u);
+  for (std::size_t k = 0; k < crop.size[2]; k += 3)
+    for (std::size_t j = 0; j < crop.size[1]; j += 3)
+      for (std::size_t i = 0; i < crop.size[0]; i += 3) {
+        const auto p = crop.index_to_physical(double(i), double(j), double(k));
+        ASSERT_NEAR(crop.at(i, j, k), 2.0 * p[0] - p[1] + 0.5 * p[2], 1e-3);
+      }
+  // Points that miss the image.
+  RowMatrixX3d far(1, 3);
+  far << 1000, 1000, 1000;
+  EXPECT_THROW(make_reference_crop(image, far, o), InputError);
+}
+
+TEST(ReferenceImageSection, RoundTripsAndRefusesDamage) {
+  Volume r;
+  r.size = {9, 10, 11};
+  r.spacing = {1.5, 2, 2.5};
+  r.origin = {-3, 4.25, 100};
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.3, Eigen::Vector3d(0, 0, 1)).toRotationMatrix();
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) r.direction[3 * a + b] = R(a, b);
+  r.data.resize(r.num_voxels());
+  for (std::size_t i = 0; i < r.data.size(); ++i) r.data[i] = 0.001f * static_cast<float>(i) - 0.25f;
+  const std::vector<std::uint8_t> bytes = serialize_reference_image(r);
+  EXPECT_EQ(bytes.size(), 144 + 4 * r.num_voxels() + 8);
+  const Volume back = deserialize_reference_image(bytes);
+  EXPECT_EQ(back.size, r.size);
+  EXPECT_EQ(back.spacing, r.spacing);
+  EXPECT_EQ(back.origin, r.origin);
+  EXPECT_EQ(back.direction, r.direction);
+  EXPECT_EQ(back.data, r.data);
+
+  std::vector<std::uint8_t> flipped = bytes;
+  flipped[144 + 40] ^= 0x10;  // one intensity
+  EXPECT_THROW(deserialize_reference_image(flipped), InputError);
+  std::vector<std::uint8_t> truncated(bytes.begin(), bytes.end() - 9);
+  EXPECT_THROW(deserialize_reference_image(truncated), InputError);
+  std::vector<std::uint8_t> magic = bytes;
+  magic[0] = 'X';
+  EXPECT_THROW(deserialize_reference_image(magic), InputError);
+  std::vector<std::uint8_t> tiny = bytes;
+  tiny[12] = 2;  // n_x = 2: impossible (and the checksum no longer matches either)
+  EXPECT_THROW(deserialize_reference_image(tiny), InputError);
+}
+
+TEST(ReferenceImageSection, SurvivesTheModelRoundTripAndADamagedFileIsRefused) {
+  const test::Hierarchy h = test::bumpy_sphere(2);  // radius ~10 mm about (3, -2, 5)
+  ShapeModel model = make_model(h.conn, h.finest);
+  Volume image;
+  image.size = {48, 44, 40};
+  image.spacing = {1.0, 1.0, 1.25};
+  image.origin = {-21, -24, -20};
+  image.data.resize(image.num_voxels());
+  for (std::size_t k = 0; k < image.size[2]; ++k)
+    for (std::size_t j = 0; j < image.size[1]; ++j)
+      for (std::size_t i = 0; i < image.size[0]; ++i) {
+        const auto p = image.index_to_physical(double(i), double(j), double(k));
+        const double d = std::hypot(p[0] - 3, p[1] + 2, p[2] - 5);
+        image.at(i, j, k) = static_cast<float>(d < 10 ? 200 + i % 3 : 50 + j % 5);
+      }
+  add_reference_image(model, image);
+  ASSERT_EQ(model.sections.count(kReferenceImageSection), 1u);
+  const Volume stored = deserialize_reference_image(model.sections.at(kReferenceImageSection));
+
+  const fs::path dir = test::scratch_dir("reference-image-section");
+  save_model((dir / "m.model").string(), model);
+  const ShapeModel loaded = load_model((dir / "m.model").string());
+  ASSERT_EQ(loaded.sections.count(kReferenceImageSection), 1u);
+  EXPECT_EQ(loaded.sections.at(kReferenceImageSection), model.sections.at(kReferenceImageSection));
+  const SnakeModel snake = snake_model_from(loaded);
+  ASSERT_TRUE(snake.reference_image.has_value());
+  EXPECT_EQ(snake.reference_image->data, stored.data);
+  EXPECT_EQ(snake.reference_image->origin, stored.origin);
+  // The crop holds the surface with its margin (clamped to the image here).
+  for (int a = 0; a < 3; ++a) EXPECT_EQ(stored.size[a], image.size[a]);
+  // Normalized by the whole image's robust window: the object near 1, the background near 0.
+  const auto centre = stored.physical_to_index({3, -2, 5});
+  EXPECT_NEAR(stored.at(std::size_t(centre[0]), std::size_t(centre[1]), std::size_t(centre[2])), 1.0, 0.05);
+  EXPECT_NEAR(stored.at(0, 0, 0), 0.0, 0.05);
+
+  // One byte of the section file changed: the model is refused with a message naming it.
+  const fs::path file = dir / "m.model" / "reference_image.bin";
+  ASSERT_TRUE(fs::exists(file));
+  std::vector<std::uint8_t> bytes = read_all(file);
+  bytes[bytes.size() / 2] ^= 0x01;
+  write_all(file, bytes);
+  try {
+    load_model((dir / "m.model").string());
+    ADD_FAILURE() << "a damaged reference image section was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("reference_image"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+TEST(SegmentCommand, InitRegisterReachesTheEndToEndBound) {
+  // build-model --image stores the reference crop; segment --init register places the model
+  // by the registration alone (no fit), then the snake.
+  const auto dir = test::scratch_dir("segment-register");
+  const std::string d = dir.string();
+  for (const auto& [name, seed] : {std::pair<std::string, int>{"ref", 32}, {"tgt", 31}}) {
+    const auto r = test::run_mrsnake("-q synth --shape blob --size 56 --snr 4 --pose random --deform 2 --seed " +
+                                     std::to_string(seed) + " -o " + d + "/" + name);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  const auto b = test::run_mrsnake("-q build-model --labels " + d + "/ref/truth.nii.gz --label 1 --image " + d +
+                                   "/ref/image.nii.gz -o " + d + "/blob.model --faces 8000");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const auto info = test::run_mrsnake("model-info " + d + "/blob.model --json");
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  const nlohmann::json mi = nlohmann::json::parse(info.output);
+  ASSERT_TRUE(mi["reference_image"].is_object()) << info.output;
+  EXPECT_TRUE(mi["manifest"]["sections"].contains("reference_image"));
+
+  const auto s = test::run_mrsnake("segment --image " + d + "/tgt/image.nii.gz --model " + d + "/blob.model -o " + d +
+                                   "/seg --init register --truth " + d + "/tgt/truth.nii.gz --json -q");
+  ASSERT_EQ(s.exit_code, 0) << s.output;
+  const nlohmann::json rep = nlohmann::json::parse(s.output);
+  EXPECT_EQ(rep["init"], "register");
+  EXPECT_EQ(rep["init_used"], "register");
+  ASSERT_TRUE(rep.contains("registration"));
+  EXPECT_TRUE(rep["registration"]["accepted"].get<bool>()) << rep["registration"].dump();
+  EXPECT_LT(rep["registration"]["final_metric"].get<double>(), rep["registration"]["initial_metric"].get<double>());
+  EXPECT_TRUE(rep["stage_seconds"].contains("register"));
+  EXPECT_EQ(rep["self_intersections"], 0);
+  EXPECT_GE(rep["scores"]["dice"].get<double>(), 0.95);
+  std::printf("segment --init register: registration %.3f s (scale %.4f, rotation %.2f deg), Dice %.4f ASSD %.3f mm\n",
+              rep["stage_seconds"]["register"].get<double>(), rep["registration"]["transform"]["scale"].get<double>(),
+              rep["registration"]["transform"]["rotation_deg"].get<double>(), rep["scores"]["dice"].get<double>(),
+              rep["scores"]["assd_mm"].get<double>());
+
+  // The default (auto) takes the registration route, then the fit.
+  const auto a = test::run_mrsnake("segment --image " + d + "/tgt/image.nii.gz --model " + d + "/blob.model -o " + d +
+                                   "/seg-auto --truth " + d + "/tgt/truth.nii.gz --json -q");
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const nlohmann::json ra = nlohmann::json::parse(a.output);
+  EXPECT_EQ(ra["init"], "auto");
+  EXPECT_EQ(ra["init_used"], "register+fit");
+  EXPECT_GE(ra["scores"]["dice"].get<double>(), 0.95);
+  fs::remove_all(dir);
+}
