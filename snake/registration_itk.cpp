@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -214,6 +215,7 @@ Volume crop_volume(const Volume& image, const std::array<long, 3>& lo, const std
 
 RegistrationResult register_similarity(const Volume& fixed, const Volume& moving, const RegistrationOptions& o) {
   const auto t0 = Clock::now();
+  const std::clock_t cpu0 = std::clock();
   if (fixed.data.size() != fixed.num_voxels() || moving.data.size() != moving.num_voxels())
     throw Error("internal: image buffer does not match its size");
   for (int a = 0; a < 3; ++a)
@@ -254,8 +256,12 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
 
   const auto eval_points = grid_points(fixed, 16000);
   try {
+    const auto t_eval = Clock::now();
     result.initial_metric =
         evaluate_metric(o, fixed_image, moving_image, transform, eval_points, &result.valid_points_initial);
+    result.evaluation_seconds = std::chrono::duration<double>(Clock::now() - t_eval).count();
+    result.setup_seconds = std::chrono::duration<double>(t_eval - t0).count();
+    const auto t_opt = Clock::now();
 
     auto metric = make_metric(o);
     auto optimizer = Optimizer::New();
@@ -335,14 +341,18 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
     if (!result.iterations.empty()) result.iterations.back() = guard->iterations - counter->at_start;
     result.stop_condition = guard->timed_out ? "time budget spent" : optimizer->GetStopConditionDescription();
 
+    result.optimization_seconds = std::chrono::duration<double>(Clock::now() - t_opt).count();
     const Transform* final_transform = registration->GetTransformOutput()->Get();
     result.transform = to_plain(final_transform);
+    const auto t_eval2 = Clock::now();
     result.final_metric =
         evaluate_metric(o, fixed_image, moving_image, final_transform, eval_points, &result.valid_points_final);
+    result.evaluation_seconds += std::chrono::duration<double>(Clock::now() - t_eval2).count();
   } catch (const itk::ExceptionObject& e) {
     throw AlgorithmError(std::string("image registration failed: ") + e.GetDescription());
   }
   result.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  result.cpu_seconds = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
   return result;
 }
 

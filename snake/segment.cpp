@@ -378,6 +378,11 @@ nlohmann::json segment_report(const SegmentResult& r) {
       reg["iterations_per_level"] = x.iterations;
       reg["stop_condition"] = x.stop_condition;
       reg["moving_crop_size"] = x.moving_crop_size;
+      reg["edge_radius_mm"] = x.edge_radius_mm;
+      reg["cpu_seconds"] = x.cpu_seconds;
+      reg["seconds_setup"] = x.setup_seconds;
+      reg["seconds_evaluation"] = x.evaluation_seconds;
+      reg["seconds_optimization"] = x.optimization_seconds;
       reg["transform"] = {{"scale", x.transform.scale},
                           {"rotation_deg", x.transform.angle_deg},
                           {"versor_xyzw", x.transform.versor},
