@@ -14,11 +14,13 @@
 #include <nlohmann/json.hpp>
 
 #include "mesh/errors.h"
+#include "mesh/primitives.h"
 #include "snake/image_pyramid.h"
 #include "snake/initialize.h"
 #include "snake/model_bridge.h"
 #include "snake/reference_image.h"
 #include "snake/registration_itk.h"
+#include "snake/segment.h"
 #include "snake/synth.h"
 #include "tests/test_support.h"
 #include "tests/wavelets/hierarchies.h"
@@ -170,6 +172,46 @@ TEST(Registration, RejectsAScaleOutsideItsRangeAndAnImageElsewhere) {
   EXPECT_FALSE(f.ran);
   EXPECT_FALSE(f.accepted);
   EXPECT_NE(f.rejection.find("overlap"), std::string::npos) << f.rejection;
+}
+
+TEST(Registration, SegmentFallsBackToTheMomentsRouteAndSaysSo) {
+  // A reference image that lies far from the new image: the registration is rejected,
+  // segment takes moments+fit instead and its report says why.
+  SynthOptions o;
+  o.shape = SynthShape::sphere;
+  o.size = {48, 48, 48};
+  o.snr = 8;
+  o.seed = 3;
+  const SynthResult target = render_synth(draw_synth_params(o));
+  const TriMesh ico = icosahedron();
+  const SubdivisionConnectivity conn = subdivide_connectivity(ico.F, 12, 2);
+  const Eigen::RowVector3d centre = target.truth_mesh.V.colwise().mean();
+  RowMatrixX3d finest = test::sphere_directions(conn, ico.V) * 12.0;
+  finest.rowwise() += centre;
+  SnakeModel model = midpoint_frame_model(conn, finest);
+  Volume reference = reference_crop(target.image, finest);
+  reference.origin[2] += 1000.0;
+  model.reference_image = reference;
+  SegmentOptions options;
+  options.force = ForceMode::step_edge;
+  options.init = InitMode::registration_and_fit;
+  options.count_self_intersections = false;
+  const SegmentResult r = segment(target.image, model, options);
+  ASSERT_TRUE(r.registration.has_value());
+  EXPECT_FALSE(r.registration->accepted);
+  EXPECT_EQ(r.init, InitMode::moments_and_fit);
+  const nlohmann::json rep = segment_report(r);
+  EXPECT_EQ(rep["init_used"], "moments+fit");
+  EXPECT_EQ(rep["registration"]["accepted"], false);
+  EXPECT_EQ(rep["registration"]["fallback"], "moments+fit");
+  EXPECT_NE(rep["registration"]["rejection"].get<std::string>().find("overlap"), std::string::npos) << rep["registration"];
+  // Without a reference image, asking for the registration is an input error; auto falls
+  // back silently.
+  model.reference_image.reset();
+  EXPECT_THROW(segment(target.image, model, options), InputError);
+  options.init = InitMode::automatic;
+  options.snake.max_iterations = 0;
+  EXPECT_EQ(segment(target.image, model, options).init, InitMode::moments_and_fit);
 }
 
 TEST(Registration, CropKeepsThePhysicalPlaceAndAverages) {
