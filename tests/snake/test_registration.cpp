@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -280,6 +281,29 @@ TEST(ReferenceImageSection, RoundTripsAndRefusesDamage) {
   std::vector<std::uint8_t> tiny = bytes;
   tiny[12] = 2;  // n_x = 2: impossible (and the checksum no longer matches either)
   EXPECT_THROW(deserialize_reference_image(tiny), InputError);
+  // Every truncation is refused.
+  for (std::size_t n = 0; n < bytes.size(); ++n)
+    EXPECT_THROW(deserialize_reference_image(std::vector<std::uint8_t>(bytes.begin(), bytes.begin() + long(n))), InputError)
+        << n << " bytes";
+  // Impossible frames and values behind a valid checksum are refused too.
+  const auto with_double = [&](std::size_t offset, double value) {
+    std::vector<std::uint8_t> b(bytes.begin(), bytes.end() - 8);
+    std::memcpy(b.data() + offset, &value, 8);
+    const std::uint64_t h = fnv1a64(b.data(), b.size());
+    const auto* p = reinterpret_cast<const std::uint8_t*>(&h);
+    b.insert(b.end(), p, p + 8);
+    return b;
+  };
+  EXPECT_NO_THROW(deserialize_reference_image(with_double(24, 1.5)));  // the same spacing: still valid
+  EXPECT_THROW(deserialize_reference_image(with_double(24, 0.0)), InputError);                 // spacing x
+  EXPECT_THROW(deserialize_reference_image(with_double(56, std::nan(""))), InputError);        // origin y
+  EXPECT_THROW(deserialize_reference_image(with_double(72, 2.0)), InputError);                 // direction (0,0)
+  std::vector<std::uint8_t> nan_value(bytes.begin(), bytes.end() - 8);
+  const float nan = std::nanf("");
+  std::memcpy(nan_value.data() + 144, &nan, 4);
+  const std::uint64_t h = fnv1a64(nan_value.data(), nan_value.size());
+  nan_value.insert(nan_value.end(), reinterpret_cast<const std::uint8_t*>(&h), reinterpret_cast<const std::uint8_t*>(&h) + 8);
+  EXPECT_THROW(deserialize_reference_image(nan_value), InputError);
 }
 
 TEST(ReferenceImageSection, SurvivesTheModelRoundTripAndADamagedFileIsRefused) {
