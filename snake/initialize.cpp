@@ -262,7 +262,8 @@ Similarity fit_similarity_to_targets(RowMatrixX3d& V, const RowMatrixX3i& F, con
 
 ReferenceRegistration register_reference(const Volume& reference, const std::vector<const Volume*>& pyramid,
                                          double level0_scale, double level0_offset,
-                                         const ReferenceRegistrationOptions& options) {
+                                         const ReferenceRegistrationOptions& options,
+                                         const Eigen::Vector3d& start_translation) {
   const auto t0 = std::chrono::steady_clock::now();
   ReferenceRegistration out;
   std::vector<double> spacings;
@@ -270,6 +271,7 @@ ReferenceRegistration register_reference(const Volume& reference, const std::vec
   const double ref_spacing = std::max({reference.spacing[0], reference.spacing[1], reference.spacing[2]});
   out.pyramid_level = pyramid_level_for_edge(ref_spacing, spacings, 1.0);
   RegistrationOptions ro = options.itk;
+  for (int a = 0; a < 3; ++a) ro.initial_translation[a] = start_translation[a];
   if (out.pyramid_level == 0) {
     ro.moving_intensity_scale = level0_scale;
     ro.moving_intensity_offset = level0_offset;

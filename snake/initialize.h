@@ -3,6 +3,7 @@
 /// Initial pose of the model in a new volume: a similarity from the moments of a rough
 /// threshold, then (optionally) a fit of the whole coarse mesh to its own search targets,
 /// which does most of the work on real images.
+#include <array>
 #include <limits>
 #include <string>
 #include <vector>
@@ -104,6 +105,10 @@ struct ReferenceRegistration {
   RegistrationResult result;  ///< ITK's outcome (when it ran)
   int pyramid_level = 0;      ///< the level of the new image's pyramid registered to
   double seconds = 0;
+  /// When the start from the identity was rejected and a second start (the moments'
+  /// translation) was tried: the first rejection and that start.
+  std::string first_rejection;
+  std::array<double, 3> retry_translation{0, 0, 0};
 };
 
 /// Registers the model's reference image (FIXED) to the new image (MOVING), on the level of
@@ -112,8 +117,10 @@ struct ReferenceRegistration {
 /// at the start, or if the scale leaves [min_scale, max_scale].
 /// `level0_scale`, `level0_offset` normalize pyramid[0] when it holds raw intensities.
 /// \pre pyramid is not empty.
+/// `start_translation` (mm) moves the reference before the registration (default none).
 ReferenceRegistration register_reference(const Volume& reference, const std::vector<const Volume*>& pyramid,
                                          double level0_scale, double level0_offset,
-                                         const ReferenceRegistrationOptions& options = {});
+                                         const ReferenceRegistrationOptions& options = {},
+                                         const Eigen::Vector3d& start_translation = Eigen::Vector3d::Zero());
 
 }  // namespace mrsnake

@@ -226,11 +226,14 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
 
   // The centre of the fixed image: the rotation and the scale act about it.
   const auto centre = fixed.index_to_physical(0.5 * (fixed.size[0] - 1.0), 0.5 * (fixed.size[1] - 1.0), 0.5 * (fixed.size[2] - 1.0));
-  // The part of the moving image the fixed image can reach from the (identity) start.
+  // The part of the moving image the fixed image can reach from the start.
   std::vector<std::array<double, 3>> corners;
-  for (int c = 0; c < 8; ++c)
-    corners.push_back(fixed.index_to_physical((c & 1) ? fixed.size[0] - 1.0 : 0.0, (c & 2) ? fixed.size[1] - 1.0 : 0.0,
-                                              (c & 4) ? fixed.size[2] - 1.0 : 0.0));
+  for (int c = 0; c < 8; ++c) {
+    auto q = fixed.index_to_physical((c & 1) ? fixed.size[0] - 1.0 : 0.0, (c & 2) ? fixed.size[1] - 1.0 : 0.0,
+                                     (c & 4) ? fixed.size[2] - 1.0 : 0.0);
+    for (int a = 0; a < 3; ++a) q[a] += o.initial_translation[a];
+    corners.push_back(q);
+  }
   std::array<long, 3> lo{}, hi{};
   if (!index_box_of_points(moving, corners, o.moving_margin_fraction, o.moving_margin_mm, lo, hi))
     throw InputError("the model's reference image does not overlap the image; use another --init");
@@ -253,6 +256,9 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
   transform->SetCenter(c);
   transform->SetIdentity();
   transform->SetCenter(c);
+  Transform::OutputVectorType start;
+  for (int a = 0; a < 3; ++a) start[a] = o.initial_translation[a];
+  transform->SetTranslation(start);
 
   const auto eval_points = grid_points(fixed, 16000);
   try {

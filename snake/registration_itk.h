@@ -48,6 +48,8 @@ struct RegistrationOptions {
   /// A linear map applied to the moving image's intensities (e.g. its normalization, so
   /// that mean squares compares like with like).
   double moving_intensity_scale = 1.0, moving_intensity_offset = 0.0;
+  /// The start: a translation (mm) of the fixed image (identity rotation and scale).
+  std::array<double, 3> initial_translation{0, 0, 0};
   double max_seconds = 1.0;                    ///< stop the optimizer past this time (a guard)
   int threads = 1;                             ///< ITK work units (1: one thread)
 };
@@ -84,7 +86,8 @@ struct RegistrationResult {
 };
 
 /// Registers `fixed` to `moving` with a Similarity3DTransform (versor, translation, scale)
-/// about the centre of the fixed image, starting from the identity: a multi-resolution
+/// about the centre of the fixed image, starting from options.initial_translation (by
+/// default the identity: both images in the same physical space): a multi-resolution
 /// ImageRegistrationMethodv4 with the chosen metric and regular step gradient descent
 /// (parameter scales from physical shifts). The moving image is first cropped to where the
 /// fixed image can land. Nothing is judged here: the caller compares initial and final

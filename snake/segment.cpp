@@ -216,23 +216,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   InitMode init = options.init;
   if (init == InitMode::automatic)
     init = model.reference_image ? InitMode::registration_and_fit : InitMode::moments_and_fit;
-  if (init == InitMode::registration || init == InitMode::registration_and_fit) {
-    // Register the model's reference image to this one; on failure, the moments route.
-    if (!model.reference_image)
-      throw InputError("--init " + to_string(init) + " needs a model with a reference image (build-model --image)");
-    report(progress, "register", 0.0);
-    result.registration = register_reference(*model.reference_image, pyramid, level0_raw ? norm_scale : 1.0,
-                                             level0_raw ? norm_offset : 0.0, options.registration);
-    end_stage("register");
-    if (result.registration->accepted) {
-      pose = result.registration->pose;
-      V = pose.apply(V);
-    } else
-      init = init == InitMode::registration ? InitMode::moments : InitMode::moments_and_fit;
-  }
-  const bool registered = result.registration && result.registration->accepted;
-  result.init = init;
-  if (init == InitMode::moments || init == InitMode::moments_and_fit) {
+  const auto moments_pose = [&] {
     // Moments on a coarse level (noise averaged out), of a mid-resolution model level.
     const int p = std::min<int>(2, static_cast<int>(pyramid.size()) - 1);
     const int jm = std::min(L, 2);
@@ -243,7 +227,46 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
                      0.7 * (model.appearance->region.inside - model.appearance->region.outside);
       mo.bright_object = model.appearance->region.inside > model.appearance->region.outside;
     }
-    pose = moments_alignment(*pyramid[p], TriMesh{model.levels[jm], model.faces(jm)}, mo);
+    return moments_alignment(*pyramid[p], TriMesh{model.levels[jm], model.faces(jm)}, mo);
+  };
+  if (init == InitMode::registration || init == InitMode::registration_and_fit) {
+    // Register the model's reference image to this one, from the model's pose; if that is
+    // rejected, once more from the moments' translation; then the moments route.
+    if (!model.reference_image)
+      throw InputError("--init " + to_string(init) + " needs a model with a reference image (build-model --image)");
+    report(progress, "register", 0.0);
+    const double s0 = level0_raw ? norm_scale : 1.0, o0 = level0_raw ? norm_offset : 0.0;
+    result.registration = register_reference(*model.reference_image, pyramid, s0, o0, options.registration);
+    if (!result.registration->accepted) {
+      Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+      bool have_shift = false;
+      try {
+        const Eigen::Vector3d c = model.levels[0].colwise().mean().transpose();
+        shift = moments_pose().apply(c) - c;
+        have_shift = true;
+      } catch (const AlgorithmError&) {  // nothing to align to: no second start
+      }
+      if (have_shift && shift.norm() > 0.5 * max_spacing(*model.reference_image)) {
+        const double first_seconds = result.registration->seconds;
+        const std::string first_rejection = result.registration->rejection;
+        result.registration = register_reference(*model.reference_image, pyramid, s0, o0, options.registration, shift);
+        result.registration->seconds += first_seconds;
+        result.registration->first_rejection = first_rejection;
+        for (int a = 0; a < 3; ++a) result.registration->retry_translation[a] = shift[a];
+      }
+    }
+    end_stage("register");
+    if (result.registration->accepted) {
+      pose = result.registration->pose;
+      V = pose.apply(V);
+    } else {
+      init = init == InitMode::registration ? InitMode::moments : InitMode::moments_and_fit;
+    }
+  }
+  const bool registered = result.registration && result.registration->accepted;
+  result.init = init;
+  if (init == InitMode::moments || init == InitMode::moments_and_fit) {
+    pose = moments_pose();
     V = pose.apply(V);
   }
   // Start hypotheses for the fit: the pose found, and the same without its rotation about
@@ -368,6 +391,11 @@ nlohmann::json segment_report(const SegmentResult& r) {
     if (!g.accepted) {
       reg["rejection"] = g.rejection;
       reg["fallback"] = to_string(r.init);
+    }
+    if (!g.first_rejection.empty()) {
+      // The start from the model's pose was rejected; this is the retry from the moments' shift.
+      reg["first_rejection"] = g.first_rejection;
+      reg["retry_start_translation_mm"] = g.retry_translation;
     }
     if (g.ran) {
       const RegistrationResult& x = g.result;

@@ -151,6 +151,30 @@ TEST(Registration, PlacesTheSurfaceOfABlobWithinAVoxel) {
   EXPECT_LT(e.scale, 0.02);
 }
 
+TEST(Registration, StartsFromAGivenTranslation) {
+  // The target's frame moved 60 mm away: from the identity there is no overlap; from the
+  // right start translation the pose is found again (the retry of segment's registration
+  // routes starts from the moments' shift this way).
+  PosedPair pair = posed_pair(SynthShape::ellipsoid, 48, 8.0);
+  const Volume crop = reference_crop(pair.reference.image, pair.reference.truth_mesh.V);
+  Volume normalized = pair.target.image;
+  normalize_intensities(normalized);
+  std::vector<Volume> pyramid = build_pyramid(normalized, 4);
+  const Eigen::Vector3d shift(60.0, 0.0, -60.0);
+  for (Volume& v : pyramid)
+    for (int a = 0; a < 3; ++a) v.origin[a] += shift[a];
+  EXPECT_FALSE(register_reference(crop, pointers(pyramid), 1.0, 0.0).accepted);
+  const ReferenceRegistration r = register_reference(crop, pointers(pyramid), 1.0, 0.0, {}, shift);
+  ASSERT_TRUE(r.accepted) << r.rejection;
+  double mean_error = 0;
+  const RowMatrixX3d& V = pair.reference.truth_mesh.V;
+  for (int v = 0; v < V.rows(); ++v) {
+    const Eigen::Vector3d x = V.row(v).transpose();
+    mean_error += (r.pose.apply(x) - (apply_pose(pair.pose, x) + shift)).norm() / V.rows();
+  }
+  EXPECT_LT(mean_error, 1.0);
+}
+
 TEST(Registration, RejectsAScaleOutsideItsRangeAndAnImageElsewhere) {
   const PosedPair pair = posed_pair(SynthShape::blob, 48, 8.0);
   const Volume crop = reference_crop(pair.reference.image, pair.reference.truth_mesh.V);
