@@ -5,6 +5,7 @@
 #include <itkImageRegistrationMethodv4.h>
 #include <itkMattesMutualInformationImageToImageMetricv4.h>
 #include <itkMeanSquaresImageToImageMetricv4.h>
+#include <itkMultiThreaderBase.h>
 #include <itkPointSet.h>
 #include <itkRegularStepGradientDescentOptimizerv4.h>
 #include <itkSimilarity3DTransform.h>
@@ -261,6 +262,14 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
   transform->SetTranslation(start);
 
   const auto eval_points = grid_points(fixed, 16000);
+  // ITK's own filters inside the registration (smoothing, shrinking, the metric's helpers)
+  // take the global default thread count: o.threads for the span of the registration, so
+  // that it runs on one thread and repeats bit for bit.
+  struct GlobalThreads {
+    itk::ThreadIdType saved = itk::MultiThreaderBase::GetGlobalDefaultNumberOfThreads();
+    explicit GlobalThreads(int n) { itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(static_cast<itk::ThreadIdType>(n)); }
+    ~GlobalThreads() { itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(saved); }
+  } threads(std::max(1, o.threads));
   try {
     const auto t_eval = Clock::now();
     result.initial_metric =
@@ -270,6 +279,8 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
     const auto t_opt = Clock::now();
 
     auto metric = make_metric(o);
+    // One work unit: one thread, and sums in one order, so that a run repeats bit for bit.
+    metric->SetMaximumNumberOfWorkUnits(static_cast<itk::ThreadIdType>(std::max(1, o.threads)));
     auto optimizer = Optimizer::New();
     optimizer->SetLearningRate(o.initial_step_mm);
     optimizer->SetMinimumStepLength(o.min_step_mm);
