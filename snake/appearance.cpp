@@ -144,6 +144,10 @@ Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes) {
   a.inside_spread = r.get<double>();
   a.outside_spread = r.get<double>();
   a.shell_mm = r.get<double>();
+  // The segmentation divides by the spreads and compares with the medians: a non-finite one
+  // would silently derail it, so it is a defect of the model, not a value to use.
+  for (double x : {a.region.inside, a.region.outside, a.inside_spread, a.outside_spread, a.shell_mm})
+    if (!std::isfinite(x)) throw InputError("the model's appearance section holds non-finite statistics; rebuild the model");
   for (int j = 0; j < levels; ++j) {
     LevelAppearance l;
     l.spacing_mm = r.get<double>();
@@ -154,6 +158,8 @@ Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes) {
     l.profiles.resize(rows, cols);
     for (int i = 0; i < rows; ++i)
       for (int c = 0; c < cols; ++c) l.profiles(i, c) = r.get<float>();
+    if (!l.profiles.allFinite() || !std::isfinite(l.spacing_mm))
+      throw InputError("the model's appearance section holds non-finite profiles; rebuild the model");
     a.levels.push_back(std::move(l));
   }
   if (r.pos != bytes.size()) throw InputError("the model's appearance section has trailing bytes; rebuild the model");

@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "mesh/errors.h"
@@ -343,6 +344,13 @@ TEST(Appearance, SerializationRoundTripsAndRejectsDamage) {
   auto bad = bytes;
   bad[0] = 'X';
   EXPECT_THROW(deserialize_appearance(bad), InputError);
+  // A non-finite profile sample or statistic is a defect, not a value the snake should use.
+  Appearance nan_profile = a;
+  nan_profile.levels[1].profiles(3, 2) = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_THROW(deserialize_appearance(serialize_appearance(nan_profile)), InputError);
+  Appearance infinite_spread = a;
+  infinite_spread.outside_spread = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(deserialize_appearance(serialize_appearance(infinite_spread)), InputError);
 }
 
 TEST(Snake, AdversarialTargetsNeverFlipAFace) {
