@@ -1,8 +1,12 @@
 #include "remesh/domain.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <unordered_map>
+#include <utility>
+#include <vector>
 
 namespace mrsnake {
 namespace {
@@ -77,10 +81,17 @@ std::vector<bool> boundary_vertices(const RowMatrixX3i& F, int num_vertices) {
 }
 
 DomainMesh::DomainMesh(RowMatrixX3d D, RowMatrixX3i F) : D_(std::move(D)), F_(std::move(F)) {
-  std::unordered_map<std::uint64_t, int> directed;
-  directed.reserve(3 * F_.rows());
+  // Directed edges -> face, as sorted (key, face) pairs (faster than hashing on large meshes);
+  // a repeated key resolves to its last face, as a map filled in face order would.
+  std::vector<std::pair<std::uint64_t, int>> directed;
+  directed.reserve(3 * static_cast<std::size_t>(F_.rows()));
   for (int f = 0; f < F_.rows(); ++f)
-    for (int e = 0; e < 3; ++e) directed[directed_key(F_(f, e), F_(f, (e + 1) % 3))] = f;
+    for (int e = 0; e < 3; ++e) directed.emplace_back(directed_key(F_(f, e), F_(f, (e + 1) % 3)), f);
+  std::sort(directed.begin(), directed.end());
+  const auto face_of = [&directed](std::uint64_t key) {
+    auto it = std::upper_bound(directed.begin(), directed.end(), std::make_pair(key, std::numeric_limits<int>::max()));
+    return it != directed.begin() && (--it)->first == key ? it->second : -1;
+  };
   edge_normal_.resize(F_.rows(), 9);
   for (int f = 0; f < F_.rows(); ++f) {
     const Eigen::Vector3d a = D_.row(F_(f, 0)), b = D_.row(F_(f, 1)), c = D_.row(F_(f, 2));
@@ -93,8 +104,7 @@ DomainMesh::DomainMesh(RowMatrixX3d D, RowMatrixX3i F) : D_(std::move(D)), F_(st
     for (int corner = 0; corner < 3; ++corner) {
       // The edge opposite `corner` runs from corner+1 to corner+2.
       const int a = F_(f, (corner + 1) % 3), b = F_(f, (corner + 2) % 3);
-      const auto it = directed.find(directed_key(b, a));
-      neighbor_(f, corner) = it == directed.end() ? -1 : it->second;
+      neighbor_(f, corner) = face_of(directed_key(b, a));
     }
 }
 
