@@ -86,6 +86,21 @@ TEST(BuildModelCli, McSpacingZeroUsesTheVoxelSurface) {
   EXPECT_EQ(run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + (dir / "bad").string() + " --mc-spacing -1")
                 .exit_code,
             2);
+
+  // A coarse image is not resampled: by default its voxels' own surface is used.
+  Volume coarse_grid = read_volume(labels);
+  coarse_grid.spacing = {2.5, 2.0, 3.0};
+  const std::string coarse_labels = (dir / "coarse.nii.gz").string();
+  write_volume(coarse_labels, coarse_grid, VoxelType::uint8);
+  const auto built = run_mrsnake("-q build-model --labels " + coarse_labels + " --label 3 -o " +
+                                 (dir / "coarse.model").string() + " --faces 2048 --json");
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  EXPECT_EQ(nlohmann::json::parse(built.output)["mc_spacing_mm"].get<double>(), 0.0);
+  const auto coarse_mc =
+      run_mrsnake("-q mc --labels " + coarse_labels + " --label 3 -o " + (dir / "coarse.vtp").string() + " --json");
+  ASSERT_EQ(coarse_mc.exit_code, 0) << coarse_mc.output;
+  EXPECT_EQ(nlohmann::json::parse(built.output)["input_faces"].get<int>(),
+            nlohmann::json::parse(coarse_mc.output)["faces"].get<int>());
 }
 
 TEST(BuildModelCli, BadInputsGetExitCodes) {
