@@ -1,5 +1,6 @@
 // mrsnake build-model --labels IMG --label N -o MODEL: marching cubes, semi-regular
 // remeshing and wavelet analysis, written as a model folder (wavelets/model_io.h).
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -25,6 +26,7 @@ void add_build_model_command(CLI::App& app) {
   struct Args {
     std::string labels, output, predict = "butterfly", image;
     int label = 1, levels = 0, faces = 32768, smooth = 20, close_tunnels = 0;
+    double mc_spacing = -1;  // automatic: see --mc-spacing
     bool full_report = false, json = false, compare_unrelaxed = false;
     double reference_margin_mm = 20.0;
   };
@@ -38,8 +40,15 @@ void add_build_model_command(CLI::App& app) {
   levels->excludes(faces);
   cmd->add_option("--predict", a->predict, "Wavelet predict step: butterfly (default) or linear")
       ->check(CLI::IsMember({"butterfly", "linear"}));
-  cmd->add_option("--smooth", a->smooth, "Windowed-sinc smoothing iterations of the marching-cubes surface (default 20; 0 = none)")
-      ->check(CLI::Range(0, 1000));
+  auto* smooth = cmd->add_option("--smooth", a->smooth,
+                                 "Windowed-sinc smoothing iterations of the marching-cubes surface (default 5, or 20 with "
+                                 "--mc-spacing 0 to remove the voxel staircase; 0 = none)")
+                     ->check(CLI::Range(0, 1000));
+  cmd->add_option("--mc-spacing", a->mc_spacing,
+                  "Marching cubes on the label's Gaussian-smoothed occupancy resampled to this isotropic spacing in mm "
+                  "(default: 1.2 if the image has voxels finer than that, else 0): a smooth surface of a size the model "
+                  "needs; 0 = the voxels' own surface (as 'mrsnake mc', much slower on a large fine label)")
+      ->check(CLI::Range(0.0, 100.0));
   cmd->add_option("--close-tunnels", a->close_tunnels,
                   "If the label's surface is not genus 0, close the label with radii up to this many voxels until it "
                   "is (as 'mrsnake mc --close-tunnels'); 0 = no repair")
@@ -60,7 +69,7 @@ void add_build_model_command(CLI::App& app) {
       "Example: mrsnake build-model --labels liver-labels.nii.gz --label 255 --image liver.nii.gz -o liver.model "
       "--faces 32768\n"
       "A label with tunnels (genus > 0): add --close-tunnels 3, e.g. the liver of abdomen-ct-small-seg.nii.gz (label 5).");
-  cmd->callback([a] {
+  cmd->callback([a, smooth] {
     using clock = std::chrono::steady_clock;
     const auto progress = terminal_progress();
     std::vector<std::pair<std::string, double>> timings;
@@ -76,9 +85,17 @@ void add_build_model_command(CLI::App& app) {
     const Volume labels = read_volume(a->labels);
     lap("read");
 
+    // 1.2 mm keeps the liver's thin parts (docs/bench-build-model.md). An image whose voxels
+    // are all 1.2 mm or coarser gains nothing from resampling (same size, and 5 smoothing
+    // iterations leave more of its staircase than 20): its voxels' own surface is used.
+    const double finest_voxel = *std::min_element(labels.spacing.begin(), labels.spacing.end());
+    const double mc_spacing = a->mc_spacing >= 0 ? a->mc_spacing : (finest_voxel < 1.2 ? 1.2 : 0.0);
+    // The resampled occupancy has no staircase left to smooth away: a few iterations do.
+    const int smoothing = smooth->count() == 0 && mc_spacing > 0 ? 5 : a->smooth;
     LabelSurfaceOptions mc;
-    mc.smoothing_iterations = a->smooth;
+    mc.smoothing_iterations = smoothing;
     mc.max_closing_radius = a->close_tunnels;
+    mc.resample_spacing_mm = mc_spacing;
     const LabelSurface surface = extract_label_surface(labels, a->label, mc, progress);
     if (!surface.dropped_component_faces.empty())
       warn("label " + std::to_string(a->label) + " has " + std::to_string(surface.components_found) +
@@ -132,6 +149,9 @@ void add_build_model_command(CLI::App& app) {
     const int L = hierarchy.connectivity.levels();
     quality["finest_level_quality"] = mesh_quality(hierarchy.mesh(L));
     quality["input_faces"] = surface.mesh.num_faces();
+    quality["marching_cubes"] = {{"spacing_mm", mc_spacing},
+                                 {"smoothing_iterations", smoothing},
+                                 {"faces", surface.mesh.num_faces()}};
     model.remesh_quality = quality;
     // The manifest records every stage up to the write; the write's own time is printed.
     model.timings = timings;
@@ -174,6 +194,7 @@ void add_build_model_command(CLI::App& app) {
                   {"vertex_counts", conn.vertex_counts},
                   {"faces", conn.faces.back().rows()},
                   {"input_faces", surface.mesh.num_faces()},
+                  {"mc_spacing_mm", mc_spacing},
                   {"closing_radius_voxels", surface.closing_radius},
                   {"finest_level_quality", quality["finest_level_quality"]},
                   {"detail_stats", stats},

@@ -16,6 +16,7 @@ void add_mc_command(CLI::App& app) {
     int label = 1;
     int smooth = 0;
     int close_tunnels = 0;
+    double spacing = 0;
     bool json = false;
   };
   auto a = std::make_shared<Args>();
@@ -27,8 +28,14 @@ void add_mc_command(CLI::App& app) {
   cmd->add_option("--close-tunnels", a->close_tunnels,
                   "If the surface is not genus 0, close the label with radii up to this many voxels until it is")
       ->check(CLI::Range(0, 20));
+  cmd->add_option("--spacing", a->spacing,
+                  "Extract the 0.5 isosurface of the label's Gaussian-smoothed occupancy resampled to this isotropic "
+                  "spacing in mm (as 'mrsnake build-model --mc-spacing'); 0 = the voxels' own surface (default)")
+      ->check(CLI::Range(0.0, 100.0));
   cmd->add_flag("--json", a->json, "Print a JSON summary");
-  cmd->footer("Example: mrsnake mc --labels liver-labels.nii.gz --label 255 --smooth 20 -o liver.vtp");
+  cmd->footer("Example: mrsnake mc --labels liver-labels.nii.gz --label 255 --smooth 20 -o liver.vtp\n"
+              "The surface build-model uses by default: mrsnake mc --labels liver-labels.nii.gz --label 255 --spacing 1.2 "
+              "--smooth 5 -o liver-1.2mm.vtp");
   cmd->callback([a] {
     const auto progress = terminal_progress();
     report(progress, "reading " + a->labels, 0.0);
@@ -36,6 +43,7 @@ void add_mc_command(CLI::App& app) {
     LabelSurfaceOptions options;
     options.smoothing_iterations = a->smooth;
     options.max_closing_radius = a->close_tunnels;
+    options.resample_spacing_mm = a->spacing;
     const LabelSurface surface = extract_label_surface(labels, a->label, options, progress);
     if (!surface.dropped_component_faces.empty()) {
       // Components are sorted largest first: the first few sizes say enough.

@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mesh/errors.h"
+#include "mesh/parallel.h"
 
 namespace mrsnake {
 namespace {
@@ -116,20 +117,29 @@ SurfaceLocator::Hit SurfaceLocator::closest(const Eigen::Vector3d& p) const {
 
 Eigen::VectorXd SurfaceLocator::distances(const RowMatrixX3d& P) const {
   Eigen::VectorXd d(P.rows());
-  for (Eigen::Index i = 0; i < P.rows(); ++i) {
-    const Point q = to_cgal(P.row(i));
-    d[i] = std::sqrt(impl_->tree.squared_distance(q));
-  }
+  // The tree (and its search hints) are built; const queries are thread-safe, and each
+  // distance is independent of the others.
+  parallel_ranges(static_cast<std::size_t>(P.rows()), [&](std::size_t begin, std::size_t end) {
+    for (auto i = static_cast<Eigen::Index>(begin); i < static_cast<Eigen::Index>(end); ++i)
+      d[i] = std::sqrt(impl_->tree.squared_distance(to_cgal(P.row(i))));
+  });
   return d;
 }
 
 SurfaceDistance surface_distance(const TriMesh& mesh, const TriMesh& reference, const DistanceOptions& options) {
   if (mesh.empty() || reference.empty())
     throw InputError("a surface distance needs two meshes with at least one face each");
+  return surface_distance(mesh, reference, SurfaceLocator(reference), options);
+}
+
+SurfaceDistance surface_distance(const TriMesh& mesh, const TriMesh& reference, const SurfaceLocator& reference_locator,
+                                 const DistanceOptions& options) {
+  if (mesh.empty() || reference.empty())
+    throw InputError("a surface distance needs two meshes with at least one face each");
   std::mt19937_64 rng(options.seed);
   const RowMatrixX3d on_mesh = sample_surface(mesh, options.samples_per_face, rng);
   const RowMatrixX3d on_reference = sample_surface(reference, options.samples_per_face, rng);
-  const Eigen::VectorXd forward = SurfaceLocator(reference).distances(on_mesh);
+  const Eigen::VectorXd forward = reference_locator.distances(on_mesh);
   const Eigen::VectorXd backward = SurfaceLocator(mesh).distances(on_reference);
 
   SurfaceDistance r;

@@ -52,6 +52,13 @@ struct SurfaceDistance {
 /// \throw InputError if either mesh has no face.
 SurfaceDistance surface_distance(const TriMesh& mesh, const TriMesh& reference, const DistanceOptions& options = {});
 
+/// The same, with a locator already built on `reference`: several meshes measured against
+/// one reference build its tree once.
+/// \pre reference_locator was built on `reference`; both meshes have at least one face.
+/// 	hrow InputError if either mesh has no face.
+SurfaceDistance surface_distance(const TriMesh& mesh, const TriMesh& reference, const SurfaceLocator& reference_locator,
+                                 const DistanceOptions& options = {});
+
 /// Number of pairs of faces that intersect (not counting neighbours that only share a
 /// vertex or an edge). 0 for a valid closed surface. Faces with a repeated corner are ignored.
 /// \throw TopologyError if a face makes the mesh non-manifold or inconsistently oriented

@@ -11,6 +11,7 @@
 
 #include "mesh/errors.h"
 #include "mesh/label_repair.h"
+#include "mesh/label_resample.h"
 #include "mesh/topology.h"
 #include "mesh/vtk_convert.h"
 
@@ -83,19 +84,38 @@ namespace {
 LabelSurface extract_once(const Volume& labels, int label, const LabelSurfaceOptions& options,
                           const ProgressFn& progress) {
   const auto target = static_cast<float>(label);
-  // Pad with a value that is not the label, so that objects touching the border close.
-  const float outside = target == 0.0f ? 1.0f : 0.0f;
-  vtkNew<vtkDiscreteFlyingEdges3D> mc;
-  mc->SetInputData(to_index_space_image(labels, 1, outside));
-  mc->SetValue(0, target);
-  mc->ComputeNormalsOff();
-  mc->ComputeGradientsOff();
-  mc->ComputeScalarsOff();
-  mc->Update();
-  TriMesh mesh = from_polydata(mc->GetOutput());
-  if (mesh.empty()) throw InputError("label " + std::to_string(label) + " gives an empty surface");
+  TriMesh mesh;
+  if (options.resample_spacing_mm > 0) {
+    OccupancyOptions occupancy;
+    occupancy.spacing_mm = options.resample_spacing_mm;
+    const Volume field = label_occupancy(labels, label, occupancy);
+    vtkNew<vtkFlyingEdges3D> mc;
+    mc->SetInputData(to_index_space_image(field, 1, 0.0f));
+    mc->SetValue(0, 0.5);
+    mc->ComputeNormalsOff();
+    mc->ComputeGradientsOff();
+    mc->ComputeScalarsOff();
+    mc->Update();
+    mesh = from_polydata(mc->GetOutput());
+    if (mesh.empty())
+      throw InputError("label " + std::to_string(label) + " gives an empty surface at a spacing of " +
+                       std::to_string(options.resample_spacing_mm) + " mm; use a finer spacing");
+    index_to_physical(field, mesh);
+  } else {
+    // Pad with a value that is not the label, so that objects touching the border close.
+    const float outside = target == 0.0f ? 1.0f : 0.0f;
+    vtkNew<vtkDiscreteFlyingEdges3D> mc;
+    mc->SetInputData(to_index_space_image(labels, 1, outside));
+    mc->SetValue(0, target);
+    mc->ComputeNormalsOff();
+    mc->ComputeGradientsOff();
+    mc->ComputeScalarsOff();
+    mc->Update();
+    mesh = from_polydata(mc->GetOutput());
+    if (mesh.empty()) throw InputError("label " + std::to_string(label) + " gives an empty surface");
+    index_to_physical(labels, mesh);
+  }
   report(progress, "marching cubes", 0.5);
-  index_to_physical(labels, mesh);
 
   LabelSurface result;
   auto components = connected_components(mesh);

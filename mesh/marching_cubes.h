@@ -18,6 +18,11 @@ struct LabelSurfaceOptions {
   /// When the surface is not genus 0, retry after closing the label (label_repair.h) with
   /// radii 1..max_closing_radius voxels until it is. 0 = no repair.
   int max_closing_radius = 0;
+  /// > 0: extract the 0.5 isosurface (flying edges) of the label's Gaussian-smoothed
+  /// occupancy resampled to this isotropic spacing in mm (mesh/label_resample.h) instead of
+  /// the voxels' own surface: no staircase, and a surface whose size follows the spacing
+  /// rather than the image's resolution. 0 = the voxels' surface (discrete flying edges).
+  double resample_spacing_mm = 0;
 };
 
 /// What was extracted, with anything worth a warning.
@@ -29,8 +34,9 @@ struct LabelSurface {
   int closing_radius = 0;          ///< closing radius (voxels) that made it genus 0; 0 = none
 };
 
-/// Extracts the surface of the voxels equal to `label` with discrete flying edges, oriented
-/// outward, optionally smoothed, keeping the largest component.
+/// Extracts the surface of the voxels equal to `label` with discrete flying edges (or of their
+/// resampled occupancy, see LabelSurfaceOptions::resample_spacing_mm), oriented outward,
+/// optionally smoothed, keeping the largest component.
 /// \throw InputError if no voxel has the label (message lists the labels present), or if
 ///        the surface is empty.
 LabelSurface extract_label_surface(const Volume& labels, int label, const LabelSurfaceOptions& options = {},

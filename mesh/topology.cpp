@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <cstdint>
 #include <unordered_map>
 
 #include <nlohmann/json.hpp>
@@ -55,10 +56,11 @@ TopologyReport topology_report(const TriMesh& mesh) {
   const double diag = bounding_box_diagonal(mesh.V);
   const double area_eps = 1e-14 * diag * diag;
 
-  // Directed half-edges -> count; undirected edges -> face count.
-  std::unordered_map<std::uint64_t, int> directed, undirected;
-  directed.reserve(3 * m);
-  undirected.reserve(3 * m);
+  // Directed half-edges and undirected edges as sorted keys (runs = counts): sorting is
+  // several times faster than hashing on meshes of hundreds of thousands of faces.
+  std::vector<std::uint64_t> directed, undirected;
+  directed.reserve(3 * static_cast<std::size_t>(m));
+  undirected.reserve(3 * static_cast<std::size_t>(m));
   std::vector<char> used(n, 0);
   UnionFind faces_uf(n);
   for (int f = 0; f < m; ++f) {
@@ -73,29 +75,37 @@ TopologyReport topology_report(const TriMesh& mesh) {
       const int u = mesh.F(f, k), v = mesh.F(f, (k + 1) % 3);
       used[u] = 1;
       if (u == v) continue;
-      ++directed[key(u, v)];
-      ++undirected[key(std::min(u, v), std::max(u, v))];
+      directed.push_back(key(u, v));
+      undirected.push_back(key(std::min(u, v), std::max(u, v)));
       faces_uf.unite(u, v);
     }
   }
+  std::sort(directed.begin(), directed.end());
+  std::sort(undirected.begin(), undirected.end());
   r.referenced_vertices = static_cast<int>(std::count(used.begin(), used.end(), 1));
-  r.edges = static_cast<int>(undirected.size());
 
   // Boundary edges and loops: boundary vertices are joined by boundary edges; a loop is a
   // component of that graph (a vertex where two loops touch is counted non-manifold below).
   UnionFind boundary_uf(n);
   std::vector<char> on_boundary(n, 0);
-  for (const auto& [k, count] : undirected) {
+  for (std::size_t i = 0; i < undirected.size();) {
+    std::size_t j = i + 1;
+    while (j < undirected.size() && undirected[j] == undirected[i]) ++j;
+    const std::size_t count = j - i;
+    const std::uint64_t k = undirected[i];
     const int u = static_cast<int>(k >> 32), v = static_cast<int>(k & 0xffffffffu);
+    ++r.edges;
     if (count == 1) {
       ++r.boundary_edges;
       boundary_uf.unite(u, v);
       on_boundary[u] = on_boundary[v] = 1;
     } else if (count > 2) {
       ++r.non_manifold_edges;
-    } else if (directed[key(u, v)] != 1) {
-      ++r.inconsistently_oriented_edges;
+    } else {
+      const auto range = std::equal_range(directed.begin(), directed.end(), key(u, v));
+      if (range.second - range.first != 1) ++r.inconsistently_oriented_edges;
     }
+    i = j;
   }
   for (int v = 0; v < n; ++v)
     if (on_boundary[v] && boundary_uf.find(v) == v) ++r.boundary_loops;
@@ -103,24 +113,38 @@ TopologyReport topology_report(const TriMesh& mesh) {
     if (used[v] && faces_uf.find(v) == v) ++r.components;
 
   // Non-manifold vertices: the link (opposite edges of the incident faces) must be connected.
-  std::vector<std::vector<int>> incident(n);
+  // Incident faces in one flat array (offsets per vertex); a star's link vertices are
+  // numbered by their rank in its sorted list.
+  std::vector<int> offset(n + 1, 0), incident(3 * static_cast<std::size_t>(m));
   for (int f = 0; f < m; ++f)
-    for (int k = 0; k < 3; ++k) incident[mesh.F(f, k)].push_back(f);
-  std::unordered_map<int, int> local;
+    for (int k = 0; k < 3; ++k) ++offset[mesh.F(f, k) + 1];
+  for (int v = 0; v < n; ++v) offset[v + 1] += offset[v];
+  {
+    std::vector<int> fill(offset.begin(), offset.end() - 1);
+    for (int f = 0; f < m; ++f)
+      for (int k = 0; k < 3; ++k) incident[fill[mesh.F(f, k)]++] = f;
+  }
+  std::vector<int> link, parent;
   for (int v = 0; v < n; ++v) {
-    if (incident[v].size() < 2) continue;
-    local.clear();
-    std::vector<int> parent;
-    auto id = [&](int w) {
-      auto [it, inserted] = local.try_emplace(w, static_cast<int>(parent.size()));
-      if (inserted) parent.push_back(it->second);
-      return it->second;
-    };
+    if (offset[v + 1] - offset[v] < 2) continue;
+    link.clear();
+    for (int i = offset[v]; i < offset[v + 1]; ++i) {
+      int others[2], c = 0;
+      for (int k = 0; k < 3 && c < 2; ++k)
+        if (mesh.F(incident[i], k) != v) others[c++] = mesh.F(incident[i], k);
+      if (c == 2) link.insert(link.end(), others, others + 2);
+    }
+    std::sort(link.begin(), link.end());
+    link.erase(std::unique(link.begin(), link.end()), link.end());
+    parent.resize(link.size());
+    std::iota(parent.begin(), parent.end(), 0);
+    auto id = [&](int w) { return static_cast<int>(std::lower_bound(link.begin(), link.end(), w) - link.begin()); };
     auto find = [&](int x) {
       while (parent[x] != x) x = parent[x] = parent[parent[x]];
       return x;
     };
-    for (int f : incident[v]) {
+    for (int i = offset[v]; i < offset[v + 1]; ++i) {
+      const int f = incident[i];
       int others[2], c = 0;
       for (int k = 0; k < 3 && c < 2; ++k)
         if (mesh.F(f, k) != v) others[c++] = mesh.F(f, k);

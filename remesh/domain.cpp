@@ -1,8 +1,12 @@
 #include "remesh/domain.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <unordered_map>
+#include <utility>
+#include <vector>
 
 namespace mrsnake {
 namespace {
@@ -77,17 +81,30 @@ std::vector<bool> boundary_vertices(const RowMatrixX3i& F, int num_vertices) {
 }
 
 DomainMesh::DomainMesh(RowMatrixX3d D, RowMatrixX3i F) : D_(std::move(D)), F_(std::move(F)) {
-  std::unordered_map<std::uint64_t, int> directed;
-  directed.reserve(3 * F_.rows());
+  // Directed edges -> face, as sorted (key, face) pairs (faster than hashing on large meshes);
+  // a repeated key resolves to its last face, as a map filled in face order would.
+  std::vector<std::pair<std::uint64_t, int>> directed;
+  directed.reserve(3 * static_cast<std::size_t>(F_.rows()));
   for (int f = 0; f < F_.rows(); ++f)
-    for (int e = 0; e < 3; ++e) directed[directed_key(F_(f, e), F_(f, (e + 1) % 3))] = f;
+    for (int e = 0; e < 3; ++e) directed.emplace_back(directed_key(F_(f, e), F_(f, (e + 1) % 3)), f);
+  std::sort(directed.begin(), directed.end());
+  const auto face_of = [&directed](std::uint64_t key) {
+    auto it = std::upper_bound(directed.begin(), directed.end(), std::make_pair(key, std::numeric_limits<int>::max()));
+    return it != directed.begin() && (--it)->first == key ? it->second : -1;
+  };
+  edge_normal_.resize(F_.rows(), 9);
+  for (int f = 0; f < F_.rows(); ++f) {
+    const Eigen::Vector3d a = D_.row(F_(f, 0)), b = D_.row(F_(f, 1)), c = D_.row(F_(f, 2));
+    edge_normal_.row(f).segment<3>(0) = b.cross(c).transpose();
+    edge_normal_.row(f).segment<3>(3) = c.cross(a).transpose();
+    edge_normal_.row(f).segment<3>(6) = a.cross(b).transpose();
+  }
   neighbor_.resize(F_.rows(), 3);
   for (int f = 0; f < F_.rows(); ++f)
     for (int corner = 0; corner < 3; ++corner) {
       // The edge opposite `corner` runs from corner+1 to corner+2.
       const int a = F_(f, (corner + 1) % 3), b = F_(f, (corner + 2) % 3);
-      const auto it = directed.find(directed_key(b, a));
-      neighbor_(f, corner) = it == directed.end() ? -1 : it->second;
+      neighbor_(f, corner) = face_of(directed_key(b, a));
     }
 }
 
@@ -95,8 +112,10 @@ DomainMesh::Location DomainMesh::locate(const Eigen::Vector3d& p, int hint) cons
   int f = (hint >= 0 && hint < F_.rows()) ? hint : 0;
   const int max_steps = static_cast<int>(F_.rows()) + 16;
   for (int step = 0; step < max_steps; ++step) {
-    const Eigen::Vector3d a = D_.row(F_(f, 0)), b = D_.row(F_(f, 1)), c = D_.row(F_(f, 2));
-    const Eigen::Vector3d lambda(domain_orientation(p, b, c), domain_orientation(a, p, c), domain_orientation(a, b, p));
+    // det(p, b, c) = p·(b×c), det(a, p, c) = p·(c×a), det(a, b, p) = p·(a×b).
+    const double* n = edge_normal_.row(f).data();
+    const Eigen::Vector3d lambda(p.x() * n[0] + p.y() * n[1] + p.z() * n[2], p.x() * n[3] + p.y() * n[4] + p.z() * n[5],
+                                 p.x() * n[6] + p.y() * n[7] + p.z() * n[8]);
     int cross = -1;
     bool outside_only = true;  // every violated edge is a boundary edge
     for (int k = 0; k < 3; ++k) {
@@ -115,7 +134,7 @@ DomainMesh::Location DomainMesh::locate(const Eigen::Vector3d& p, int hint) cons
       if (lambda.minCoeff() >= 0 && lambda.sum() > 0) {
         loc.barycentric = lambda / lambda.sum();
       } else if (outside_only) {
-        loc.barycentric = closest_barycentric(p, a, b, c);
+        loc.barycentric = closest_barycentric(p, D_.row(F_(f, 0)), D_.row(F_(f, 1)), D_.row(F_(f, 2)));
       } else {
         return brute_force(p);
       }

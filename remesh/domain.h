@@ -51,6 +51,9 @@ class DomainMesh {
   RowMatrixX3d D_;
   RowMatrixX3i F_;
   RowMatrixX3i neighbor_;  ///< neighbor_(f, e): face across the edge opposite corner e, -1 on the boundary
+  /// Per face, the cross products b×c, c×a, a×b of its corners: p's barycentric weight of
+  /// corner e is p·edge_normal_(f, e), one dot product instead of a determinant per test.
+  Eigen::Matrix<double, Eigen::Dynamic, 9, Eigen::RowMajor> edge_normal_;
 };
 
 }  // namespace mrsnake

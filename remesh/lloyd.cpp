@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mesh/parallel.h"
+
 namespace mrsnake {
 namespace {
 
@@ -73,46 +75,57 @@ LloydStats constrained_lloyd(DomainKind kind, const RowMatrixX3i& F, const Densi
 
   Eigen::VectorXd mass(n);
   RowMatrixX3d moment(n, 3);
+  std::vector<std::array<double, 3>> weight(m);
+  std::vector<std::array<Eigen::Vector3d, 3>> corner_centroid(m);
   for (int it = 0; it < options.iterations; ++it) {
     mass.setZero();
     moment.setZero();
-    for (int f = 0; f < m; ++f) {
-      const Eigen::Vector3d P[3] = {U.row(F(f, 0)), U.row(F(f, 1)), U.row(F(f, 2))};
-      const double third = 0.5 * (P[1] - P[0]).cross(P[2] - P[0]).norm() / 3.0;
-      Eigen::Vector3d centroid[3];
-      double rho[3];
-      for (int k = 0; k < 3; ++k) centroid[k] = quad_centroid(P[k], P[(k + 1) % 3], P[(k + 2) % 3]);
-      if (r <= 2) {
-        for (int k = 0; k < 3; ++k) rho[k] = density.at(centroid[k], face_hint[f]);
-      } else {
-        // Mean density over the grid samples falling in each corner's quadrilateral (the
-        // region where that corner's barycentric coordinate is the largest).
-        double sum[3] = {0, 0, 0}, count[3] = {0, 0, 0};
-        auto sample = [&](double x, double y) {
-          const Eigen::Vector3d l(1 - x - y, x, y);
-          const double value = density.at(l[0] * P[0] + l[1] * P[1] + l[2] * P[2], face_hint[f]);
-          const double top = l.maxCoeff();
-          int ties = 0;
-          for (int k = 0; k < 3; ++k) ties += l[k] >= top - 1e-12;
-          for (int k = 0; k < 3; ++k)
-            if (l[k] >= top - 1e-12) {
-              sum[k] += value / ties;
-              count[k] += 1.0 / ties;
+    // The density integrals of the faces are independent (each face walks from its own
+    // hint): computed in parallel, then summed in face order as before.
+    parallel_ranges(static_cast<std::size_t>(m), [&](std::size_t begin, std::size_t end) {
+      for (int f = static_cast<int>(begin); f < static_cast<int>(end); ++f) {
+        const Eigen::Vector3d P[3] = {U.row(F(f, 0)), U.row(F(f, 1)), U.row(F(f, 2))};
+        const double third = 0.5 * (P[1] - P[0]).cross(P[2] - P[0]).norm() / 3.0;
+        Eigen::Vector3d centroid[3];
+        double rho[3];
+        for (int k = 0; k < 3; ++k) centroid[k] = quad_centroid(P[k], P[(k + 1) % 3], P[(k + 2) % 3]);
+        if (r <= 2) {
+          for (int k = 0; k < 3; ++k) rho[k] = density.at(centroid[k], face_hint[f]);
+        } else {
+          // Mean density over the grid samples falling in each corner's quadrilateral (the
+          // region where that corner's barycentric coordinate is the largest).
+          double sum[3] = {0, 0, 0}, count[3] = {0, 0, 0};
+          auto sample = [&](double x, double y) {
+            const Eigen::Vector3d l(1 - x - y, x, y);
+            const double value = density.at(l[0] * P[0] + l[1] * P[1] + l[2] * P[2], face_hint[f]);
+            const double top = l.maxCoeff();
+            int ties = 0;
+            for (int k = 0; k < 3; ++k) ties += l[k] >= top - 1e-12;
+            for (int k = 0; k < 3; ++k)
+              if (l[k] >= top - 1e-12) {
+                sum[k] += value / ties;
+                count[k] += 1.0 / ties;
+              }
+          };
+          for (int i = 0; i < r; ++i)
+            for (int j = 0; i + j < r; ++j) {
+              sample((i + 1.0 / 3) / r, (j + 1.0 / 3) / r);
+              if (i + j <= r - 2) sample((i + 2.0 / 3) / r, (j + 2.0 / 3) / r);
             }
-        };
-        for (int i = 0; i < r; ++i)
-          for (int j = 0; i + j < r; ++j) {
-            sample((i + 1.0 / 3) / r, (j + 1.0 / 3) / r);
-            if (i + j <= r - 2) sample((i + 2.0 / 3) / r, (j + 2.0 / 3) / r);
-          }
-        for (int k = 0; k < 3; ++k) rho[k] = count[k] > 0 ? sum[k] / count[k] : density.at(centroid[k], face_hint[f]);
+          for (int k = 0; k < 3; ++k) rho[k] = count[k] > 0 ? sum[k] / count[k] : density.at(centroid[k], face_hint[f]);
+        }
+        for (int k = 0; k < 3; ++k) {
+          weight[f][k] = rho[k] * third;
+          corner_centroid[f][k] = centroid[k];
+        }
       }
+    }, /*min_per_thread=*/16);
+    for (int f = 0; f < m; ++f)
       for (int k = 0; k < 3; ++k) {
-        const double w = rho[k] * third;
+        const double w = weight[f][k];
         mass[F(f, k)] += w;
-        moment.row(F(f, k)) += w * centroid[k].transpose();
+        moment.row(F(f, k)) += w * corner_centroid[f][k].transpose();
       }
-    }
     // Gauss-Seidel moves, each checked against the current positions of its neighbours.
     double shift = 0;
     int moved = 0;

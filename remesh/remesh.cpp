@@ -8,6 +8,7 @@
 
 #include "mesh/distance.h"
 #include "mesh/errors.h"
+#include "mesh/parallel.h"
 #include "mesh/quality.h"
 #include "remesh/base_mesh.h"
 #include "remesh/domain.h"
@@ -70,7 +71,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
 
   // A much finer input is simplified before the (costly) parameterization.
   TriMesh work = original;
-  std::unique_ptr<SurfaceLocator> reproject;
+  std::unique_ptr<SurfaceLocator> reproject, input_locator;
   const double finest_faces = 2.0 * n0 * std::pow(4.0, levels);
   const double limit = std::max<double>(options.simplify_above_faces, 8 * finest_faces);
   if (options.simplify_above_faces > 0 && original.num_faces() > limit) {
@@ -170,8 +171,10 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     }
     report(options.progress, "level " + std::to_string(j), 0.5);
     if (reproject)
-      for (int v = 0; v < level.positions.rows(); ++v)
-        level.positions.row(v) = reproject->closest(level.positions.row(v).transpose()).point.transpose();
+      parallel_ranges(static_cast<std::size_t>(level.positions.rows()), [&](std::size_t begin, std::size_t end) {
+        for (auto v = static_cast<Eigen::Index>(begin); v < static_cast<Eigen::Index>(end); ++v)
+          level.positions.row(v) = reproject->closest(level.positions.row(v).transpose()).point.transpose();
+      });
     const int flipped = count_flipped(U, F);
     if (flipped > 0)
       throw AlgorithmError("level " + std::to_string(j) + " has " + std::to_string(flipped) +
@@ -197,7 +200,9 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       DistanceOptions sampling;
       sampling.samples_per_face =
           std::clamp(static_cast<int>(5e5 / std::max(original.num_faces(), mesh.num_faces())), 1, 10);
-      s["distance"] = surface_distance(mesh, original, sampling);
+      // The input's tree is built once for every level (the reprojection's when there is one).
+      if (!reproject && !input_locator) input_locator = std::make_unique<SurfaceLocator>(original);
+      s["distance"] = surface_distance(mesh, original, reproject ? *reproject : *input_locator, sampling);
       s["distance"]["samples_per_face"] = sampling.samples_per_face;
     }
     result.levels.push_back(std::move(level));

@@ -1,6 +1,7 @@
 #include "apps/report/remesh_page.h"
 
 #include <algorithm>
+#include <memory>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -41,15 +42,18 @@ std::string setting(const nlohmann::json& v) {
 
 /// Quality and distance of one level: from its stats when remesh computed them, else
 /// computed here (distance only when the input is known).
+/// `locator` is built on `input` at the first use and reused for the other levels.
 std::pair<nlohmann::json, nlohmann::json> level_figures(const RemeshResult& result, int j, const TriMesh* input,
-                                                        int samples_per_face, bool* computed) {
+                                                        std::unique_ptr<SurfaceLocator>& locator, int samples_per_face,
+                                                        bool* computed) {
   const nlohmann::json& s = result.levels[j].stats;
   nlohmann::json quality = s.contains("quality") ? s["quality"] : nlohmann::json(mesh_quality(result.mesh(j)));
   nlohmann::json distance = s.contains("distance") ? s["distance"] : nlohmann::json();
   if (distance.is_null() && input) {
     DistanceOptions o;
     o.samples_per_face = samples_per_face;
-    distance = surface_distance(result.mesh(j), *input, o);
+    if (!locator) locator = std::make_unique<SurfaceLocator>(*input);
+    distance = surface_distance(result.mesh(j), *input, *locator, o);
     *computed = true;
   }
   return {quality, distance};
@@ -160,11 +164,12 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
   bool distance_missing = false, distance_computed = false;
   int samples = options.distance_samples_per_face;
   if (samples <= 0)
-    samples = options.input ? std::clamp(static_cast<int>(500000 / std::max<Eigen::Index>(1, options.input->num_faces())), 1, 10)
+    samples = options.input ? std::clamp(static_cast<int>(100000 / std::max<Eigen::Index>(1, options.input->num_faces())), 0, 10)
                             : 10;
+  std::unique_ptr<SurfaceLocator> input_locator;
   const auto add_rows = [&](const RemeshResult& res, const std::string& variant) {
     for (int j = 0; j <= L; ++j) {
-      const auto [q, d] = level_figures(res, j, options.input, samples, &distance_computed);
+      const auto [q, d] = level_figures(res, j, options.input, input_locator, samples, &distance_computed);
       if (d.is_null()) distance_missing = true;
       rows.push_back({std::to_string(j), variant, std::to_string(res.levels[j].positions.rows()),
                       std::to_string(res.connectivity.faces[j].rows()), cell(d, "rms_pct", 3), cell(d, "hausdorff_pct", 3),
@@ -185,9 +190,10 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
   }
   page.table(header, rows);
   if (distance_computed)
-    page.paragraph("Distances of this page: every vertex plus " + std::to_string(samples) +
-                   " random point(s) per face of each mesh, measured against the other (report.json has none: run "
-                   "with --full-report for remesh's own figures).");
+    page.paragraph("Distances of this page: every vertex" +
+                   (samples > 0 ? " plus " + std::to_string(samples) + " random point(s) per face" : std::string()) +
+                   " of each mesh, measured against the other (report.json has none: run with --full-report for "
+                   "remesh's own figures).");
   if (distance_missing) page.note("The geometric error needs the input surface; it was not given to this page.");
 
   // Renders of every level.

@@ -21,8 +21,9 @@ struct RemeshPageOptions {
   /// against it (build-model computes no stats by default). Null: such cells stay empty.
   const TriMesh* input = nullptr;
   /// Random samples per face of both meshes for those distances; 0 = automatic: 10 (as
-  /// remesh's own stats), fewer for a large input so that it gets about 500,000 samples
-  /// (the distances of every level to a 440k-face liver took 27 s with 10).
+  /// remesh's own stats), fewer for a large input so that it gets about 100,000 samples, and
+  /// none beyond the vertices for an input of more than 100,000 faces (whose vertices are
+  /// dense enough: the distances of every level to a 440k-face liver took 27 s with 10).
   int distance_samples_per_face = 0;
   /// The same input remeshed with RelaxMode::none (--compare-unrelaxed), or null.
   const RemeshResult* unrelaxed = nullptr;

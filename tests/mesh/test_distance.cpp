@@ -1,11 +1,14 @@
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "mesh/distance.h"
 #include "mesh/errors.h"
+#include "mesh/parallel.h"
 #include "mesh/primitives.h"
 
 using namespace mrsnake;
@@ -86,6 +89,44 @@ TEST(SurfaceLocator, FindsTheRightFaceOnASphere) {
                                     hit.barycentric[2] * sphere.V.row(sphere.F(f, 2)).transpose();
     EXPECT_NEAR((rebuilt - hit.point).norm(), 0.0, 1e-12);
   }
+}
+
+TEST(SurfaceLocator, ParallelDistancesEqualTheClosestPointOneByOne) {
+  // distances() splits the points over threads: every point must get its own distance.
+  const TriMesh sphere = icosphere(3, 2.0);
+  const SurfaceLocator locator(sphere);
+  RowMatrixX3d P(5000, 3);
+  for (int i = 0; i < P.rows(); ++i)
+    P.row(i) << std::sin(0.37 * i) * (1 + 0.001 * i), std::cos(0.11 * i) * 1.5, 0.0004 * i - 1;
+  const Eigen::VectorXd d = locator.distances(P);
+  ASSERT_EQ(d.size(), P.rows());
+  for (int i = 0; i < P.rows(); ++i) ASSERT_NEAR(d[i], locator.closest(P.row(i).transpose()).distance, 1e-12) << i;
+}
+
+TEST(SurfaceDistance, PrebuiltReferenceLocatorGivesTheSameNumbers) {
+  const TriMesh a = icosphere(3, 1.0);
+  TriMesh b = icosphere(2, 1.1);
+  b.V.col(0) *= 1.2;
+  const SurfaceLocator locator(b);
+  const SurfaceDistance fresh = surface_distance(a, b), reused = surface_distance(a, b, locator);
+  EXPECT_EQ(fresh.rms_mm, reused.rms_mm);
+  EXPECT_EQ(fresh.hausdorff_mm, reused.hausdorff_mm);
+  EXPECT_EQ(fresh.mean_mm, reused.mean_mm);
+  EXPECT_GT(fresh.hausdorff_mm, 0.1);
+}
+
+TEST(ParallelRanges, CoversEveryIndexOnceAndRethrows) {
+  for (std::size_t n : {0u, 1u, 7u, 1000u, 100003u}) {
+    std::vector<std::atomic<int>> hits(n);
+    parallel_ranges(n, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) ++hits[i];
+    }, 16);
+    for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(hits[i].load(), 1) << "n " << n << " index " << i;
+  }
+  EXPECT_THROW(parallel_ranges(100000, [](std::size_t, std::size_t end) {
+                 if (end == 100000) throw std::runtime_error("the last range's worker");
+               }, 16),
+               std::runtime_error);
 }
 
 TEST(SurfaceDistance, MeshAgainstItselfIsZero) {

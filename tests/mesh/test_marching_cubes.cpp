@@ -4,6 +4,7 @@
 
 #include "mesh/errors.h"
 #include "mesh/image_io.h"
+#include "mesh/label_resample.h"
 #include "mesh/marching_cubes.h"
 #include "mesh/mesh_io.h"
 #include "mesh/primitives.h"
@@ -96,6 +97,74 @@ TEST(MarchingCubes, ObliqueAnisotropicGridGivesThePhysicalPlace) {
   const LabelSurface m = extract_label_surface(mirrored, 1);
   EXPECT_GT(enclosed_volume(m.mesh), 0.0);
   EXPECT_EQ(topology_report(m.mesh).inconsistently_oriented_edges, 0);
+}
+
+TEST(MarchingCubes, ResampledOccupancyGivesTheBallWithFewerFaces) {
+  // Thick slices and an oblique, mirrored direction: the resampled surface must still be the
+  // ball, at its physical place, with the voxels' volume, closed, outward, and much smaller.
+  Volume g;
+  g.size = {56, 56, 28};
+  g.spacing = {0.6, 0.6, 1.3};
+  g.origin = {4.0, -20.0, 7.0};
+  const Eigen::Matrix3d R =
+      (Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(-0.6, Eigen::Vector3d::UnitZ())).toRotationMatrix();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) g.direction[3 * r + c] = (c == 2 ? -1.0 : 1.0) * R(r, c);
+  const auto mid = g.index_to_physical(27.5, 27.5, 13.5);
+  const Eigen::Vector3d centre(mid[0], mid[1], mid[2]);
+  std::size_t count = 0;
+  const Volume labels = voxelized_ball(g, centre, 12.0, 4, count);
+  const double voxel_volume = count * 0.6 * 0.6 * 1.3;
+
+  LabelSurfaceOptions options;
+  options.resample_spacing_mm = 1.5;
+  const LabelSurface s = extract_label_surface(labels, 4, options);
+  const auto topo = topology_report(s.mesh);
+  EXPECT_TRUE(topo.is_closed_genus0()) << topo.describe();
+  EXPECT_EQ(topo.inconsistently_oriented_edges, 0);
+  EXPECT_GT(enclosed_volume(s.mesh), 0.0) << "must be oriented outward";
+  EXPECT_NEAR(enclosed_volume(s.mesh) / voxel_volume, 1.0, 0.03);
+  const Eigen::Vector3d mesh_centre = s.mesh.V.colwise().mean().transpose();
+  EXPECT_LT((mesh_centre - centre).norm(), 0.3);
+  const Eigen::ArrayXd r = (s.mesh.V.rowwise() - centre.transpose()).rowwise().norm().array();
+  // The voxel ball's surface lies within half a voxel of the sphere; the resampled one with it.
+  EXPECT_NEAR(r.mean(), 12.0, 0.4);
+  EXPECT_LT((r - 12.0).abs().maxCoeff(), 1.0);
+
+  const LabelSurface voxels = extract_label_surface(labels, 4);
+  EXPECT_LT(s.mesh.num_faces() * 3, voxels.mesh.num_faces()) << "a 1.5 mm grid must give a much smaller surface";
+  // Halving the spacing gives about four times as many faces (the size follows the spacing).
+  options.resample_spacing_mm = 0.75;
+  const LabelSurface fine = extract_label_surface(labels, 4, options);
+  const double ratio = static_cast<double>(fine.mesh.num_faces()) / s.mesh.num_faces();
+  EXPECT_GT(ratio, 3.0);
+  EXPECT_LT(ratio, 5.0);
+  EXPECT_NEAR(enclosed_volume(fine.mesh) / voxel_volume, 1.0, 0.03);
+}
+
+TEST(MarchingCubes, OccupancyIsInZeroOneAndClosesAtTheBorder) {
+  Volume labels = grid(12, {1, 1, 1});
+  labels.data.assign(labels.num_voxels(), 2.0f);  // the whole volume is the object
+  OccupancyOptions o;
+  o.spacing_mm = 1.25;
+  const Volume field = label_occupancy(labels, 2, o);
+  for (float v : field.data) {
+    ASSERT_GE(v, 0.0f);
+    ASSERT_LE(v, 1.0f);
+  }
+  EXPECT_EQ(field.spacing[0], 1.25);
+  // The margin is ~0 all around (so the 0.5 isosurface closes), the middle is inside.
+  EXPECT_LT(field.at(0, 0, 0), 1e-3f);
+  EXPECT_LT(field.at(field.size[0] - 1, field.size[1] - 1, field.size[2] - 1), 1e-3f);
+  EXPECT_GT(field.at(field.size[0] / 2, field.size[1] / 2, field.size[2] / 2), 0.99f);
+  LabelSurfaceOptions options;
+  options.resample_spacing_mm = 1.25;
+  const LabelSurface s = extract_label_surface(labels, 2, options);
+  EXPECT_TRUE(topology_report(s.mesh).is_closed_genus0());
+  EXPECT_NEAR(enclosed_volume(s.mesh) / 1728.0, 1.0, 0.08);  // a rounded cube of 12 mm
+  EXPECT_THROW(label_occupancy(labels, 3, o), InputError);
+  o.spacing_mm = 0;
+  EXPECT_THROW(label_occupancy(labels, 2, o), std::invalid_argument);
 }
 
 TEST(MarchingCubes, KeepsTheLargestComponentAndReportsTheOthers) {

@@ -56,10 +56,51 @@ TEST(BuildModelCli, BuildsAModelThatModelInfoAccepts) {
   EXPECT_NEAR(center.y(), 30.0 + 17.5, 1.0);
   EXPECT_NEAR(center.z(), 5.0 + 15.5 * 1.25, 1.0);
   EXPECT_TRUE(m.remesh_quality.contains("finest_level_quality"));
+  // The marching cubes ran on the resampled occupancy (default 1.2 mm), recorded in model.json.
+  EXPECT_EQ(summary["mc_spacing_mm"].get<double>(), 1.2);
+  EXPECT_EQ(m.remesh_quality["marching_cubes"]["spacing_mm"].get<double>(), 1.2);
+  EXPECT_EQ(m.remesh_quality["marching_cubes"]["smoothing_iterations"].get<int>(), 5);
+  EXPECT_EQ(m.remesh_quality["marching_cubes"]["faces"].get<int>(), summary["input_faces"].get<int>());
 
   const auto info = run_mrsnake("model-info --json " + model);
   ASSERT_EQ(info.exit_code, 0) << info.output;
   EXPECT_TRUE(nlohmann::json::parse(info.output)["synthesis"]["ok"].get<bool>());
+}
+
+TEST(BuildModelCli, McSpacingZeroUsesTheVoxelSurface) {
+  const auto dir = scratch_dir("build-model-cli-spacing");
+  const std::string labels = write_ellipsoid_labels(dir);
+  const auto mc = run_mrsnake("-q mc --labels " + labels + " --label 3 -o " + (dir / "voxels.vtp").string() + " --json");
+  ASSERT_EQ(mc.exit_code, 0) << mc.output;
+  const int voxel_faces = nlohmann::json::parse(mc.output)["faces"].get<int>();
+  const auto run = [&](const std::string& spacing) {
+    const auto r = run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + (dir / ("m" + spacing)).string() +
+                               " --faces 2048 --mc-spacing " + spacing + " --json");
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    return nlohmann::json::parse(r.output);
+  };
+  EXPECT_EQ(run("0")["input_faces"].get<int>(), voxel_faces);  // exactly 'mrsnake mc''s surface
+  const int coarse = run("2")["input_faces"].get<int>();
+  EXPECT_LT(coarse * 2, voxel_faces);
+  EXPECT_GT(coarse, 200);
+  EXPECT_EQ(run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + (dir / "bad").string() + " --mc-spacing -1")
+                .exit_code,
+            2);
+
+  // A coarse image is not resampled: by default its voxels' own surface is used.
+  Volume coarse_grid = read_volume(labels);
+  coarse_grid.spacing = {2.5, 2.0, 3.0};
+  const std::string coarse_labels = (dir / "coarse.nii.gz").string();
+  write_volume(coarse_labels, coarse_grid, VoxelType::uint8);
+  const auto built = run_mrsnake("-q build-model --labels " + coarse_labels + " --label 3 -o " +
+                                 (dir / "coarse.model").string() + " --faces 2048 --json");
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  EXPECT_EQ(nlohmann::json::parse(built.output)["mc_spacing_mm"].get<double>(), 0.0);
+  const auto coarse_mc =
+      run_mrsnake("-q mc --labels " + coarse_labels + " --label 3 -o " + (dir / "coarse.vtp").string() + " --json");
+  ASSERT_EQ(coarse_mc.exit_code, 0) << coarse_mc.output;
+  EXPECT_EQ(nlohmann::json::parse(built.output)["input_faces"].get<int>(),
+            nlohmann::json::parse(coarse_mc.output)["faces"].get<int>());
 }
 
 TEST(BuildModelCli, BadInputsGetExitCodes) {
