@@ -47,6 +47,19 @@ struct RemeshOptions {
   /// triangles, moved in D (remesh/shape_smoothing.h). The Lloyd step evens out sizes but is
   /// affine invariant, so it cannot repair shear; this can. 0 = the Lloyd step alone.
   int shape_iterations = 3;
+  /// With all_vertices: sweeps per level of the final repair of the worst triangles
+  /// (remesh/triangle_repair.h): vertices of triangles with Q < repair_threshold move
+  /// tangentially, on the input, only when that raises the smallest Q around them. 0 = off.
+  int repair_sweeps = 6;
+  double repair_threshold = 0.85;
+  /// A repair move may not take the vertex's edges further from the surface than this times
+  /// before (remesh/triangle_repair.h); 0 = no limit.
+  double repair_max_chord_growth = 0;
+  /// Repair every level (true) or only the finest (false; coarse levels keep the Lloyd layout).
+  bool repair_coarse_levels = true;
+  /// Disk inputs: a base rim vertex with fewer triangles than this is dropped from the base
+  /// mesh (remesh/base_mesh.h); with 2 its corners stay obtuse at every level. 1 = keep all.
+  int rim_min_triangles = 3;
   /// Inputs with more faces than max(simplify_above_faces, 8 x the finest level's faces) are
   /// simplified to that size before parameterization (remesh/simplify.h); the result is then
   /// projected back onto the original input. 0 = never simplify.

@@ -14,11 +14,14 @@
 #include "mesh/primitives.h"
 #include "mesh/quality.h"
 #include "mesh/topology.h"
+#include "remesh/base_mesh.h"
 #include "remesh/domain.h"
+#include "remesh/lift.h"
 #include "remesh/lloyd.h"
 #include "remesh/parameterization.h"
 #include "remesh/remesh.h"
 #include "remesh/sizing.h"
+#include "remesh/triangle_repair.h"
 #include "tests/test_support.h"
 
 namespace mrsnake {
@@ -295,6 +298,98 @@ TEST(Lloyd, CellStaysInsideANonConvexOneRing) {
   EXPECT_GT(stats.moves, 0);
   // Converged to its own cell's centroid.
   EXPECT_LT((lloyd_cell_centroid(G, W, 6) - Eigen::Vector3d(W.row(6))).norm(), 1e-6);
+}
+
+// The final repair: on an ellipsoid's parameterization, a triangulation of D with a few
+// vertices pushed toward a neighbour (sliver triangles in 3D) is repaired in place: the
+// smallest Q goes up a lot, nothing flips in D, and every vertex is still the exact lift of
+// its domain position (so on the surface).
+TEST(TriangleRepair, RaisesTheWorstQualityOnTheSurfaceWithoutFlips) {
+  const TriMesh input = ellipsoid(4);
+  const Parameterization param = parameterize(input);
+  const DomainMesh domain(param.domain, param.surface.F);
+  TriMesh grid = icosphere(3);
+  RowMatrixX3d U = grid.V.rowwise().normalized();
+  const RowMatrixX3i& F = grid.F;
+  ASSERT_EQ(count_flipped(U, F), 0);
+  // Push 10 vertices 80% of the way toward a neighbour; keep only pushes that flip nothing.
+  for (int f = 0; f < 300; f += 30) {
+    const int v = F(f, 0), w = F(f, 1);
+    const Eigen::RowVector3d before = U.row(v);
+    U.row(v) = (0.2 * U.row(v) + 0.8 * U.row(w)).normalized();
+    if (count_flipped(U, F) > 0) U.row(v) = before;
+  }
+  std::vector<int> hints(U.rows(), 0);
+  RowMatrixX3d X = lift_to_surface(domain, param.surface.V, U, hints);
+  const double q_before = mesh_quality(TriMesh{X, F}).q_min;
+  ASSERT_LT(q_before, 0.3);
+  const TriangleRepairStats stats =
+      repair_worst_triangles(DomainKind::sphere, F, domain, param.surface.V, U, X, hints, TriangleRepairOptions{});
+  const double q_after = mesh_quality(TriMesh{X, F}).q_min;
+  EXPECT_GT(stats.moves, 0);
+  EXPECT_NEAR(stats.q_min_before, q_before, 1e-12);
+  EXPECT_NEAR(stats.q_min_after, q_after, 1e-12);
+  EXPECT_GT(q_after, 0.5);
+  EXPECT_EQ(count_flipped(U, F), 0);
+  for (int v = 0; v < U.rows(); ++v) EXPECT_NEAR(U.row(v).norm(), 1.0, 1e-12);
+  std::vector<int> fresh(U.rows(), 0);
+  EXPECT_LT((lift_to_surface(domain, param.surface.V, U, fresh) - X).cwiseAbs().maxCoeff(), 1e-9);
+  const SurfaceLocator locator(input);
+  EXPECT_LT(locator.distances(X).maxCoeff(), 1e-9 * bounding_box_diagonal(input.V));
+}
+
+// With repair on, no level's smallest Q is below what it is with repair off, on a disk (rim
+// vertices slide along the circle and stay on it) and on a sphere.
+TEST(TriangleRepair, NeverLowersAnyLevelsWorstTriangleAndKeepsTheRimOnTheCircle) {
+  for (const TriMesh& input : {spherical_cap(4), ellipsoid(4)}) {
+    RemeshOptions on = small_options(3, 24);
+    on.compute_stats = true;
+    RemeshOptions off = on;
+    off.repair_sweeps = 0;
+    const RemeshResult a = remesh(input, on), b = remesh(input, off);
+    expect_nested_and_valid(a, input, a.domain == "sphere");
+    int moves = 0;
+    double gain = 0;
+    for (int j = 0; j <= 3; ++j) {
+      SCOPED_TRACE("level " + std::to_string(j));
+      moves += a.levels[j].stats["repair_moves"].get<int>();
+      EXPECT_EQ(b.levels[j].stats["repair_moves"].get<int>(), 0);
+      EXPECT_GE(a.levels[j].stats["quality"]["q_min"].get<double>(), b.levels[j].stats["quality"]["q_min"].get<double>() - 1e-12);
+      EXPECT_GE(a.levels[j].stats["quality"]["q_min"].get<double>(), 0.6);
+      EXPECT_GE(a.levels[j].stats["quality"]["min_angle_deg"].get<double>(), 30.0);
+      gain += a.levels[j].stats["quality"]["q_min"].get<double>() - b.levels[j].stats["quality"]["q_min"].get<double>();
+    }
+    EXPECT_GT(moves, 0);
+    EXPECT_GT(gain, 0.02);
+  }
+}
+
+// Rim vertices of a disk's base mesh with only 2 triangles are dropped: on the mushroom the
+// old rule leaves some (their corners are ~120 degrees at every level), the new none.
+TEST(RemeshData, MushroomBaseRimVerticesHaveThreeTriangles) {
+  MRSNAKE_REQUIRE_DATA(path, "meshes/mushroom.off");
+  const Parameterization param = parameterize(read_mesh(path));
+  auto thin_rim_vertices = [](const BaseMesh& base) {
+    const int m = static_cast<int>(base.domain.rows());
+    std::vector<int> triangles(m, 0);
+    for (int f = 0; f < base.faces.rows(); ++f)
+      for (int k = 0; k < 3; ++k) ++triangles[base.faces(f, k)];
+    const std::vector<bool> rim = boundary_vertices(base.faces, m);
+    int thin = 0;
+    for (int v = 0; v < m; ++v) thin += rim[v] && triangles[v] < 3;
+    return thin;
+  };
+  int old_thin = 0;
+  for (int n0 : {66, 127, 252}) {
+    SCOPED_TRACE(n0);
+    old_thin += thin_rim_vertices(build_base_mesh(param, n0, 1));
+    const BaseMesh base = build_base_mesh(param, n0, 3);
+    EXPECT_EQ(thin_rim_vertices(base), 0);
+    EXPECT_EQ(count_flipped(base.domain, base.faces), 0);
+    EXPECT_GT(base.domain.rows(), n0 * 9 / 10);
+    EXPECT_EQ(static_cast<int>(base.domain.rows()) + base.dropped_rim_samples, n0);
+  }
+  EXPECT_GT(old_thin, 0);
 }
 
 // Real meshes: zero flipped triangles at every level (kept small for a fast suite).
