@@ -22,7 +22,6 @@ void add_remesh_command(CLI::App& app) {
     int levels = 0, faces = 16000, base_vertices = 32, iterations = 8, shape_iterations = 3;
     int repair_sweeps = RemeshOptions{}.repair_sweeps, rim_min_triangles = RemeshOptions{}.rim_min_triangles;
     double exponent = 2.0, curvature = 1.0, repair_threshold = RemeshOptions{}.repair_threshold;
-    double repair_chord_growth = RemeshOptions{}.repair_max_chord_growth;
     bool no_relax = false, strict = false, json = false, compare_unrelaxed = false;
     bool repair_finest_only = false;
   };
@@ -56,9 +55,6 @@ void add_remesh_command(CLI::App& app) {
   cmd->add_option("--repair-threshold", args->repair_threshold,
                   "Triangles with quality Q below this are repaired (default 0.85)")
       ->check(CLI::Range(0.01, 1.0));
-  cmd->add_option("--repair-chord-growth", args->repair_chord_growth,
-                  "A repair move may not take edges further from the surface than this times before (default 0 = no limit)")
-      ->check(CLI::Range(0.0, 1000.0));
   cmd->add_flag("--repair-finest-only", args->repair_finest_only, "Repair only the finest level (default: every level)");
   cmd->add_option("--rim-min-triangles", args->rim_min_triangles,
                   "Disk inputs: base rim vertices with fewer triangles are dropped (default 3; 1 = keep all)")
@@ -80,7 +76,6 @@ void add_remesh_command(CLI::App& app) {
     options.repair_sweeps = args->repair_sweeps;
     options.repair_threshold = args->repair_threshold;
     options.repair_coarse_levels = !args->repair_finest_only;
-    options.repair_max_chord_growth = args->repair_chord_growth;
     options.rim_min_triangles = args->rim_min_triangles;
     options.curvature_weight = args->curvature;
     options.relax = args->no_relax ? RelaxMode::none : args->strict ? RelaxMode::new_vertices_only : RelaxMode::all_vertices;

@@ -59,7 +59,6 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   if (options.repair_sweeps < 0) throw std::invalid_argument("repair_sweeps must be >= 0");
   if (!(options.repair_threshold > 0 && options.repair_threshold <= 1))
     throw std::invalid_argument("repair_threshold must be in (0, 1]");
-  if (!(options.repair_max_chord_growth >= 0)) throw std::invalid_argument("repair_max_chord_growth must be >= 0");
   if (options.rim_min_triangles < 1 || options.rim_min_triangles > 3)
     throw std::invalid_argument("rim_min_triangles must be in [1, 3]");
   if (options.base_vertices < 6) throw std::invalid_argument("base_vertices must be at least 6");
@@ -181,7 +180,6 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       TriangleRepairOptions repair_options;
       repair_options.sweeps = options.repair_sweeps;
       repair_options.threshold = options.repair_threshold;
-      repair_options.max_chord_error_growth = options.repair_max_chord_growth;
       repair = repair_worst_triangles(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, repair_options);
     }
     report(options.progress, "level " + std::to_string(j), 0.5);
@@ -235,7 +233,6 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["repair_sweeps"] = options.relax == RelaxMode::all_vertices ? options.repair_sweeps : 0;
   j["repair_threshold"] = options.repair_threshold;
   j["repair_coarse_levels"] = options.repair_coarse_levels;
-  j["repair_max_chord_growth"] = options.repair_max_chord_growth;
   j["rim_min_triangles"] = options.rim_min_triangles;
   j["parameterization"] = result.parameterization;
   double total = result.parameterization.value("seconds", 0.0);

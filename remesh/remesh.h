@@ -52,9 +52,6 @@ struct RemeshOptions {
   /// tangentially, on the input, only when that raises the smallest Q around them. 0 = off.
   int repair_sweeps = 6;
   double repair_threshold = 0.85;
-  /// A repair move may not take the vertex's edges further from the surface than this times
-  /// before (remesh/triangle_repair.h); 0 = no limit.
-  double repair_max_chord_growth = 0;
   /// Repair every level (true) or only the finest (false; coarse levels keep the Lloyd layout).
   bool repair_coarse_levels = true;
   /// Disk inputs: a base rim vertex with fewer triangles than this is dropped from the base

@@ -35,14 +35,10 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
       if (F(f, k) == v) P[k] = x;
     return frey_borouchaki_quality(P[0], P[1], P[2]);
   };
-  // Smallest Q of v's triangles with v at x; the sum breaks ties.
+  // Smallest Q of v's triangles with v at x.
   auto star_quality = [&](int v, const Eigen::Vector3d& x) {
-    std::pair<double, double> q{std::numeric_limits<double>::infinity(), 0.0};
-    for (int i = offset[v]; i < offset[v + 1]; ++i) {
-      const double qf = quality(star[i], v, x);
-      q.first = std::min(q.first, qf);
-      q.second += qf;
-    }
+    double q = std::numeric_limits<double>::infinity();
+    for (int i = offset[v]; i < offset[v + 1]; ++i) q = std::min(q, quality(star[i], v, x));
     return q;
   };
   auto unflipped_in_domain = [&](int v, const Eigen::Vector3d& u) {
@@ -61,22 +57,6 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
     return Eigen::Vector3d(loc.barycentric[0] * surface_V.row(PF(loc.face, 0)).transpose() +
                            loc.barycentric[1] * surface_V.row(PF(loc.face, 1)).transpose() +
                            loc.barycentric[2] * surface_V.row(PF(loc.face, 2)).transpose());
-  };
-  // How far the edges of v (at u in D, x in 3D) leave the surface: the largest distance
-  // between an edge's midpoint and the lift of the edge's midpoint in D.
-  auto chord_error = [&](int v, const Eigen::Vector3d& u, const Eigen::Vector3d& x) {
-    double error = 0;
-    int hint = hints[v];
-    for (int i = offset[v]; i < offset[v + 1]; ++i) {
-      const int f = star[i];
-      int k = 0;
-      while (F(f, k) != v) ++k;
-      for (int w : {F(f, (k + 1) % 3), F(f, (k + 2) % 3)}) {
-        const Eigen::Vector3d mid = project_to_domain(kind, 0.5 * (u + U.row(w).transpose()), false);
-        error = std::max(error, (lift(mid, hint) - 0.5 * (x + X.row(w).transpose())).norm());
-      }
-    }
-    return error;
   };
   auto smallest_q = [&]() {
     double q = std::numeric_limits<double>::infinity();
@@ -101,8 +81,8 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
         if (visited[v] == sweep || (boundary[v] && !options.move_rim)) continue;
         visited[v] = sweep;
         const Eigen::Vector3d x = X.row(v);
-        const std::pair<double, double> current = star_quality(v, x);
-        if (!(current.first < options.threshold)) continue;
+        const double current = star_quality(v, x);
+        if (!(current < options.threshold)) continue;
         Eigen::Vector3d normal = Eigen::Vector3d::Zero(), centroid = Eigen::Vector3d::Zero(), mean_apex = Eigen::Vector3d::Zero();
         Eigen::Vector3d worst_apex = x;
         double worst = std::numeric_limits<double>::infinity();
@@ -143,8 +123,7 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
         if (!(std::abs(gram.determinant()) > 0)) continue;
         const Eigen::LDLT<Eigen::Matrix2d> solver(gram);
         const Eigen::Vector3d u = U.row(v);
-        const double allowed_error = options.max_chord_error_growth * chord_error(v, u, x);
-        std::pair<double, double> best = current;
+        double best = current;
         Eigen::Vector3d best_u = u, best_x = x;
         int best_hint = hints[v];
         for (const Eigen::Vector3d& target : targets) {
@@ -156,16 +135,15 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
             if (!unflipped_in_domain(v, candidate)) continue;
             int hint = hints[v];
             const Eigen::Vector3d lifted = lift(candidate, hint);
-            const std::pair<double, double> q = star_quality(v, lifted);
-            if (!(q.first > best.first + 1e-9)) continue;
-            if (options.max_chord_error_growth > 0 && chord_error(v, candidate, lifted) > allowed_error) continue;
+            const double q = star_quality(v, lifted);
+            if (!(q > best + 1e-9)) continue;
             best = q;
             best_u = candidate;
             best_x = lifted;
             best_hint = hint;
           }
         }
-        if (!(best.first > current.first + 1e-9)) continue;
+        if (!(best > current + 1e-9)) continue;
         U.row(v) = best_u.transpose();
         X.row(v) = best_x.transpose();
         hints[v] = best_hint;

@@ -10,7 +10,7 @@
 /// half and quarter steps). Each move is pulled back to D through the Jacobian of the input
 /// triangle under the vertex and re-lifted exactly (so the vertex stays on the input surface);
 /// the candidate that raises the smallest Q of the vertex's triangles the most is kept, and
-/// only if it raises it and its edges stay as close to the surface. Connectivity is untouched (the hierarchy stays nested) and a move that
+/// only if it raises it. Connectivity is untouched (the hierarchy stays nested) and a move that
 /// would flip a triangle in D is never taken. Disk rim vertices slide along the circle.
 #include <vector>
 
@@ -23,10 +23,6 @@ struct TriangleRepairOptions {
   int sweeps = 6;            ///< passes over the poor triangles (each recomputes which are poor)
   double threshold = 0.85;   ///< triangles with Q below this are repaired
   bool move_rim = true;      ///< disk rim vertices may slide along the boundary
-  /// A move may not make the vertex's edges leave the surface more than this times as far as
-  /// before (largest distance between an edge's 3D midpoint and the lift of its midpoint in
-  /// D): better shapes must not cut across ridges. 0 = no limit.
-  double max_chord_error_growth = 0;
 };
 
 struct TriangleRepairStats {
