@@ -23,7 +23,7 @@ void add_remesh_command(CLI::App& app) {
     int repair_sweeps = RemeshOptions{}.repair_sweeps, rim_min_triangles = RemeshOptions{}.rim_min_triangles;
     double exponent = 2.0, curvature = 1.0, repair_threshold = RemeshOptions{}.repair_threshold;
     bool no_relax = false, strict = false, json = false, compare_unrelaxed = false;
-    bool repair_finest_only = false;
+    bool repair_finest_only = false, repair_no_guard = false;
   };
   auto args = std::make_shared<Args>();
   cmd->add_option("MESH", args->mesh, "Input surface (.vtp .vtk .stl .ply .obj .off): a disk or a closed genus-0 surface")
@@ -53,9 +53,11 @@ void add_remesh_command(CLI::App& app) {
                   "Sweeps per level of the final repair of the worst triangles (default 6; 0 = off; not with --strict or --no-relax)")
       ->check(CLI::Range(0, 1000));
   cmd->add_option("--repair-threshold", args->repair_threshold,
-                  "Triangles with quality Q below this are repaired (default 0.85)")
+                  "Triangles with quality Q below this are repaired (default 0.8)")
       ->check(CLI::Range(0.01, 1.0));
   cmd->add_flag("--repair-finest-only", args->repair_finest_only, "Repair only the finest level (default: every level)");
+  cmd->add_flag("--repair-no-guard", args->repair_no_guard,
+                "On the finest level, also take repair moves that take triangles further from the input");
   cmd->add_option("--rim-min-triangles", args->rim_min_triangles,
                   "Disk inputs: base rim vertices with fewer triangles are dropped (default 3; 1 = keep all)")
       ->check(CLI::Range(1, 3));
@@ -76,6 +78,7 @@ void add_remesh_command(CLI::App& app) {
     options.repair_sweeps = args->repair_sweeps;
     options.repair_threshold = args->repair_threshold;
     options.repair_coarse_levels = !args->repair_finest_only;
+    options.repair_guard_finest = !args->repair_no_guard;
     options.rim_min_triangles = args->rim_min_triangles;
     options.curvature_weight = args->curvature;
     options.relax = args->no_relax ? RelaxMode::none : args->strict ? RelaxMode::new_vertices_only : RelaxMode::all_vertices;

@@ -180,6 +180,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       TriangleRepairOptions repair_options;
       repair_options.sweeps = options.repair_sweeps;
       repair_options.threshold = options.repair_threshold;
+      repair_options.guard_surface_error = options.repair_guard_finest && j == levels;
       repair = repair_worst_triangles(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, repair_options);
     }
     report(options.progress, "level " + std::to_string(j), 0.5);
@@ -233,6 +234,7 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["repair_sweeps"] = options.relax == RelaxMode::all_vertices ? options.repair_sweeps : 0;
   j["repair_threshold"] = options.repair_threshold;
   j["repair_coarse_levels"] = options.repair_coarse_levels;
+  j["repair_guard_finest"] = options.repair_guard_finest;
   j["rim_min_triangles"] = options.rim_min_triangles;
   j["parameterization"] = result.parameterization;
   double total = result.parameterization.value("seconds", 0.0);

@@ -51,9 +51,13 @@ struct RemeshOptions {
   /// (remesh/triangle_repair.h): vertices of triangles with Q < repair_threshold move
   /// tangentially, on the input, only when that raises the smallest Q around them. 0 = off.
   int repair_sweeps = 6;
-  double repair_threshold = 0.85;
+  double repair_threshold = 0.8;
   /// Repair every level (true) or only the finest (false; coarse levels keep the Lloyd layout).
   bool repair_coarse_levels = true;
+  /// On the finest level, refuse repair moves that take triangles further from the surface
+  /// (TriangleRepairOptions::guard_surface_error): the finest level is what is measured
+  /// against the input; coarse levels only shape the layout.
+  bool repair_guard_finest = true;
   /// Disk inputs: a base rim vertex with fewer triangles than this is dropped from the base
   /// mesh (remesh/base_mesh.h); with 2 its corners stay obtuse at every level. 1 = keep all.
   int rim_min_triangles = 3;

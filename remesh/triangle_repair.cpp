@@ -10,6 +10,32 @@
 #include "mesh/quality.h"
 
 namespace mrsnake {
+namespace {
+
+// Distance from p to the triangle (a, b, c) (Ericson, Real-Time Collision Detection, 5.1.5).
+double point_triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                               const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return ap.norm();
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return bp.norm();
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (p - (a + d1 / (d1 - d3) * ab)).norm();
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return cp.norm();
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + d2 / (d2 - d6) * ac)).norm();
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return (p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
+  const double denom = 1.0 / (va + vb + vc);
+  return (p - (a + ab * (vb * denom) + ac * (vc * denom))).norm();
+}
+
+}  // namespace
 
 TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& F, const DomainMesh& param,
                                            const RowMatrixX3d& surface_V, RowMatrixX3d& U, RowMatrixX3d& X,
@@ -58,6 +84,30 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
                            loc.barycentric[1] * surface_V.row(PF(loc.face, 1)).transpose() +
                            loc.barycentric[2] * surface_V.row(PF(loc.face, 2)).transpose());
   };
+  // How far v's triangles (v at u in D, x in 3D) leave the surface: the largest distance
+  // between an edge's 3D midpoint and the lift of its midpoint in D, and (with `old` = v's
+  // position before the move, on the surface) the distance from `old` to the triangles: a
+  // move off a ridge or a tip leaves it away from them.
+  auto surface_error = [&](int v, const Eigen::Vector3d& u, const Eigen::Vector3d& x, const Eigen::Vector3d& old) {
+    double error = 0, to_old = std::numeric_limits<double>::infinity();
+    int hint = hints[v];
+    for (int i = offset[v]; i < offset[v + 1]; ++i) {
+      const int f = star[i];
+      int k = 0;
+      while (F(f, k) != v) ++k;
+      const int a = F(f, (k + 1) % 3), b = F(f, (k + 2) % 3);
+      for (int w : {a, b}) {
+        const Eigen::Vector3d mid = project_to_domain(kind, 0.5 * (u + U.row(w).transpose()), false);
+        error = std::max(error, (lift(mid, hint) - 0.5 * (x + X.row(w).transpose())).norm());
+      }
+      to_old = std::min(to_old, point_triangle_distance(old, x, X.row(a).transpose(), X.row(b).transpose()));
+    }
+    return std::max(error, to_old);
+  };
+  double mean_edge = 0;
+  for (int f = 0; f < m; ++f)
+    for (int k = 0; k < 3; ++k) mean_edge += (X.row(F(f, k)) - X.row(F(f, (k + 1) % 3))).norm();
+  mean_edge /= std::max(1, 3 * m);
   auto smallest_q = [&]() {
     double q = std::numeric_limits<double>::infinity();
     for (int f = 0; f < m; ++f) q = std::min(q, quality(f, -1, Eigen::Vector3d::Zero()));
@@ -123,6 +173,8 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
         if (!(std::abs(gram.determinant()) > 0)) continue;
         const Eigen::LDLT<Eigen::Matrix2d> solver(gram);
         const Eigen::Vector3d u = U.row(v);
+        const double allowed_error =
+            options.guard_surface_error ? std::max(surface_error(v, u, x, x), options.error_tolerance * mean_edge) : 0.0;
         double best = current;
         Eigen::Vector3d best_u = u, best_x = x;
         int best_hint = hints[v];
@@ -137,6 +189,7 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
             const Eigen::Vector3d lifted = lift(candidate, hint);
             const double q = star_quality(v, lifted);
             if (!(q > best + 1e-9)) continue;
+            if (options.guard_surface_error && surface_error(v, candidate, lifted, x) > allowed_error) continue;
             best = q;
             best_u = candidate;
             best_x = lifted;

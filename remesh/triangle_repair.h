@@ -21,8 +21,14 @@ namespace mrsnake {
 
 struct TriangleRepairOptions {
   int sweeps = 6;            ///< passes over the poor triangles (each recomputes which are poor)
-  double threshold = 0.85;   ///< triangles with Q below this are repaired
+  double threshold = 0.8;    ///< triangles with Q below this are repaired
   bool move_rim = true;      ///< disk rim vertices may slide along the boundary
+  /// Refuse moves that take the vertex's triangles further from the surface than before, or
+  /// than error_tolerance x the mean edge length if that is more (largest distance between an
+  /// edge's 3D midpoint and the lift of its midpoint in D, and from the vertex's old position
+  /// to its new triangles): better shapes must not cut across ridges or tips.
+  bool guard_surface_error = false;
+  double error_tolerance = 0.01;
 };
 
 struct TriangleRepairStats {

@@ -338,6 +338,63 @@ TEST(TriangleRepair, RaisesTheWorstQualityOnTheSurfaceWithoutFlips) {
   EXPECT_LT(locator.distances(X).maxCoeff(), 1e-9 * bounding_box_diagonal(input.V));
 }
 
+// With the surface-error guard (and no tolerance) no edge leaves the surface further than
+// before: the largest distance between an edge's 3D midpoint and the lift of its midpoint in
+// D cannot grow, since a move only changes the moved vertex's edges and must keep them within
+// the old largest. The guard does refuse moves that the unguarded repair makes.
+TEST(TriangleRepair, GuardKeepsEdgesAsCloseToTheSurface) {
+  const TriMesh input = ellipsoid(4);
+  const Parameterization param = parameterize(input);
+  const DomainMesh domain(param.domain, param.surface.F);
+  const TriMesh grid = icosphere(3);
+  RowMatrixX3d U0 = grid.V.rowwise().normalized();
+  const RowMatrixX3i& F = grid.F;
+  {
+    // Slivers at the most curved places (the ends of the long axis), where moves cut most.
+    std::vector<int> hints(U0.rows(), 0);
+    const RowMatrixX3d X0 = lift_to_surface(domain, param.surface.V, U0, hints);
+    for (int f = 0; f < F.rows(); ++f) {
+      const int v = F(f, 0), w = F(f, 1);
+      if (std::abs(X0(v, 0)) < 2.0) continue;
+      const Eigen::RowVector3d before = U0.row(v);
+      U0.row(v) = (0.5 * U0.row(v) + 0.5 * U0.row(w)).normalized();
+      if (count_flipped(U0, F) > 0) U0.row(v) = before;
+    }
+  }
+  auto largest_edge_error = [&](const RowMatrixX3d& U, const RowMatrixX3d& X) {
+    double error = 0;
+    int hint = 0;
+    for (const auto& [a, b] : edges_of(F)) {
+      const Eigen::Vector3d mid = (U.row(a) + U.row(b)).normalized().transpose();
+      const DomainMesh::Location loc = domain.locate(mid, hint);
+      hint = loc.face;
+      Eigen::Vector3d lifted = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 3; ++k) lifted += loc.barycentric[k] * param.surface.V.row(domain.faces()(loc.face, k)).transpose();
+      error = std::max(error, (lifted - 0.5 * (X.row(a) + X.row(b)).transpose()).norm());
+    }
+    return error;
+  };
+  std::vector<double> after(2);
+  std::vector<int> moves(2);
+  double before = 0;
+  for (bool guard : {true, false}) {
+    RowMatrixX3d U = U0;
+    std::vector<int> hints(U.rows(), 0);
+    RowMatrixX3d X = lift_to_surface(domain, param.surface.V, U, hints);
+    before = largest_edge_error(U, X);
+    TriangleRepairOptions options;
+    options.guard_surface_error = guard;
+    options.error_tolerance = 0;
+    const TriangleRepairStats stats = repair_worst_triangles(DomainKind::sphere, F, domain, param.surface.V, U, X, hints, options);
+    EXPECT_GT(stats.moves, 0);
+    EXPECT_GT(stats.q_min_after, stats.q_min_before);
+    after[guard ? 0 : 1] = largest_edge_error(U, X);
+    moves[guard ? 0 : 1] = stats.moves;
+  }
+  EXPECT_LE(after[0], before * (1 + 1e-9));
+  EXPECT_LT(moves[0], moves[1]);
+}
+
 // With repair on, no level's smallest Q is below what it is with repair off, on a disk (rim
 // vertices slide along the circle and stay on it) and on a sphere.
 TEST(TriangleRepair, NeverLowersAnyLevelsWorstTriangleAndKeepsTheRimOnTheCircle) {
