@@ -41,7 +41,10 @@ struct TriangleRepairStats {
 /// \pre X = lift of U onto the surface whose domain mesh is `param` (3D positions surface_V);
 ///      no triangle of (U, F) flipped in D; hints has one face of `param` per vertex.
 /// \post no triangle of (U, F) is flipped in D; the smallest Q of every moved vertex's
-///       triangles went up, so the mesh's smallest Q never goes down.
+///       triangles went up, so the mesh's smallest Q never goes down; with
+///       guard_surface_error and error_tolerance 0 the largest edge-midpoint distance to the
+///       surface never goes up either.
+/// \throw nothing (a vertex whose move cannot be computed stays put).
 TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& F, const DomainMesh& param,
                                            const RowMatrixX3d& surface_V, RowMatrixX3d& U, RowMatrixX3d& X,
                                            std::vector<int>& hints, const TriangleRepairOptions& options);
