@@ -59,6 +59,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   if (options.repair_sweeps < 0) throw std::invalid_argument("repair_sweeps must be >= 0");
   if (!(options.repair_threshold > 0 && options.repair_threshold <= 1))
     throw std::invalid_argument("repair_threshold must be in (0, 1]");
+  if (!(options.repair_error_tolerance >= 0)) throw std::invalid_argument("repair_error_tolerance must be >= 0");
   if (options.rim_min_triangles < 1 || options.rim_min_triangles > 3)
     throw std::invalid_argument("rim_min_triangles must be in [1, 3]");
   if (options.base_vertices < 6) throw std::invalid_argument("base_vertices must be at least 6");
@@ -181,6 +182,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       repair_options.sweeps = options.repair_sweeps;
       repair_options.threshold = options.repair_threshold;
       repair_options.guard_surface_error = options.repair_guard_finest && j == levels;
+      repair_options.error_tolerance = options.repair_error_tolerance;
       repair = repair_worst_triangles(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, repair_options);
     }
     report(options.progress, "level " + std::to_string(j), 0.5);
@@ -205,6 +207,10 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     s["lloyd_last_mean_shift"] = relax_stats.mean_shift;
     s["shape_moves"] = shape_moves;
     s["repair_moves"] = repair.moves;
+    if (repair.moves > 0) {
+      s["repair_q_min_before"] = repair.q_min_before;
+      s["repair_q_min_after"] = repair.q_min_after;
+    }
     if (options.compute_stats) {
       const TriMesh mesh{level.positions, F};
       s["quality"] = mesh_quality(mesh);
@@ -235,6 +241,7 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["repair_threshold"] = options.repair_threshold;
   j["repair_coarse_levels"] = options.repair_coarse_levels;
   j["repair_guard_finest"] = options.repair_guard_finest;
+  j["repair_error_tolerance"] = options.repair_error_tolerance;
   j["rim_min_triangles"] = options.rim_min_triangles;
   j["parameterization"] = result.parameterization;
   double total = result.parameterization.value("seconds", 0.0);

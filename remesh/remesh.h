@@ -58,6 +58,8 @@ struct RemeshOptions {
   /// (TriangleRepairOptions::guard_surface_error): the finest level is what is measured
   /// against the input; coarse levels only shape the layout.
   bool repair_guard_finest = true;
+  /// The guard lets triangles move away from the surface by up to this x the mean edge length.
+  double repair_error_tolerance = 0.03;
   /// Disk inputs: a base rim vertex with fewer triangles than this is dropped from the base
   /// mesh (remesh/base_mesh.h); with 2 its corners stay obtuse at every level. 1 = keep all.
   int rim_min_triangles = 3;

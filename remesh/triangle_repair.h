@@ -28,7 +28,7 @@ struct TriangleRepairOptions {
   /// edge's 3D midpoint and the lift of its midpoint in D, and from the vertex's old position
   /// to its new triangles): better shapes must not cut across ridges or tips.
   bool guard_surface_error = false;
-  double error_tolerance = 0.01;
+  double error_tolerance = 0.03;
 };
 
 struct TriangleRepairStats {
