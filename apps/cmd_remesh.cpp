@@ -20,8 +20,11 @@ void add_remesh_command(CLI::App& app) {
   struct Args {
     std::string mesh, out;
     int levels = 0, faces = 16000, base_vertices = 32, iterations = 8, shape_iterations = 3;
-    double exponent = 2.0, curvature = 1.0;
+    int repair_sweeps = RemeshOptions{}.repair_sweeps, rim_min_triangles = RemeshOptions{}.rim_min_triangles;
+    double exponent = 2.0, curvature = 1.0, repair_threshold = RemeshOptions{}.repair_threshold;
+    double repair_tolerance = RemeshOptions{}.repair_error_tolerance;
     bool no_relax = false, strict = false, json = false, compare_unrelaxed = false;
+    bool repair_finest_only = false, repair_no_guard = false;
   };
   auto args = std::make_shared<Args>();
   cmd->add_option("MESH", args->mesh, "Input surface (.vtp .vtk .stl .ply .obj .off): a disk or a closed genus-0 surface")
@@ -47,6 +50,21 @@ void add_remesh_command(CLI::App& app) {
   cmd->add_option("--shape-iterations", args->shape_iterations,
                   "Iterations per level of 3D shape smoothing after Lloyd (default 3; not with --strict or --no-relax)")
       ->check(CLI::Range(0, 1000));
+  cmd->add_option("--repair-sweeps", args->repair_sweeps,
+                  "Sweeps per level of the final repair of the worst triangles (default 6; 0 = off; not with --strict or --no-relax)")
+      ->check(CLI::Range(0, 1000));
+  cmd->add_option("--repair-threshold", args->repair_threshold,
+                  "Triangles with quality Q below this are repaired (default 0.8)")
+      ->check(CLI::Range(0.01, 1.0));
+  cmd->add_flag("--repair-finest-only", args->repair_finest_only, "Repair only the finest level (default: every level)");
+  cmd->add_flag("--repair-no-guard", args->repair_no_guard,
+                "On the finest level, also take repair moves that take triangles further from the input");
+  cmd->add_option("--repair-tolerance", args->repair_tolerance,
+                  "The guard lets triangles move away from the input by up to this x the mean edge length (default 0.03)")
+      ->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--rim-min-triangles", args->rim_min_triangles,
+                  "Disk inputs: base rim vertices with fewer triangles are dropped (default 3; 1 = keep all)")
+      ->check(CLI::Range(1, 3));
   cmd->add_flag("--compare-unrelaxed", args->compare_unrelaxed,
                 "Also remesh without relaxation (a second run) and compare both in report.html and report.json")
       ->excludes(no_relax);
@@ -61,6 +79,12 @@ void add_remesh_command(CLI::App& app) {
     options.lloyd_iterations = args->iterations;
     options.density_exponent = args->exponent;
     options.shape_iterations = args->shape_iterations;
+    options.repair_sweeps = args->repair_sweeps;
+    options.repair_threshold = args->repair_threshold;
+    options.repair_coarse_levels = !args->repair_finest_only;
+    options.repair_guard_finest = !args->repair_no_guard;
+    options.repair_error_tolerance = args->repair_tolerance;
+    options.rim_min_triangles = args->rim_min_triangles;
     options.curvature_weight = args->curvature;
     options.relax = args->no_relax ? RelaxMode::none : args->strict ? RelaxMode::new_vertices_only : RelaxMode::all_vertices;
     if (!global_options().quiet) options.progress = terminal_progress();

@@ -30,9 +30,41 @@ void farthest_points(const RowMatrixX3d& X, const std::vector<int>& candidates, 
   }
 }
 
+void triangulate_samples(const Parameterization& param, const std::vector<bool>& boundary, int rim_min_triangles,
+                         BaseMesh& base) {
+  const int m = static_cast<int>(base.samples.size());
+  base.domain.resize(m, 3);
+  for (int i = 0; i < m; ++i) base.domain.row(i) = param.domain.row(base.samples[i]);
+
+  if (param.kind == DomainKind::sphere) {
+    base.faces = convex_hull_faces(base.domain);
+  } else {
+    RowMatrixX3d lifted(m, 3);
+    for (int i = 0; i < m; ++i) {
+      if (boundary[base.samples[i]]) base.domain.row(i) = project_to_domain(DomainKind::disk, base.domain.row(i), true);
+      lifted.row(i) << base.domain(i, 0), base.domain(i, 1), base.domain(i, 0) * base.domain(i, 0) + base.domain(i, 1) * base.domain(i, 1);
+    }
+    const RowMatrixX3i hull = convex_hull_faces(lifted);
+    std::vector<Eigen::RowVector3i> lower;
+    for (int f = 0; f < hull.rows(); ++f) {
+      const Eigen::Vector3d a = lifted.row(hull(f, 0)), b = lifted.row(hull(f, 1)), c = lifted.row(hull(f, 2));
+      if ((b - a).cross(c - a).z() < 0) lower.emplace_back(hull(f, 0), hull(f, 2), hull(f, 1));
+    }
+    base.faces.resize(static_cast<int>(lower.size()), 3);
+    for (std::size_t i = 0; i < lower.size(); ++i) base.faces.row(static_cast<int>(i)) = lower[i];
+  }
+  std::set<int> used(base.faces.data(), base.faces.data() + base.faces.size());
+  if (static_cast<int>(used.size()) != m)
+    throw AlgorithmError("the base mesh does not use all of its " + std::to_string(m) +
+                         " vertices; the parameterization is too distorted for this base size (try another --faces)");
+  if (const int flipped = count_flipped(base.domain, base.faces); flipped > 0)
+    throw AlgorithmError("the base mesh has " + std::to_string(flipped) + " flipped triangles in the domain");
+  base.valence_flips += flip_toward_regular_valence(base.domain, base.faces, rim_min_triangles);
+}
+
 }  // namespace
 
-int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F) {
+int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F, int rim_min_triangles) {
   const int n = static_cast<int>(D.rows());
   int flips = 0;
   for (int pass = 0; pass < 50; ++pass) {
@@ -62,7 +94,10 @@ int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F) {
       const int c = F(f1, fc.second), d = F(f2, twin->second.second);
       if (c == d || edge_faces.count({c, d}) || edge_faces.count({d, c}) || created.count({std::min(c, d), std::max(c, d)}))
         continue;
-      if (valence[a] <= 3 || valence[b] <= 3) continue;
+      // Never below 3 edges inside, or rim_min_triangles + 1 on the rim: a rim vertex with 2
+      // triangles splits a ~180-240 degree rim angle into two obtuse corners at every level.
+      const int rim_floor = std::max(3, rim_min_triangles + 1);
+      if (valence[a] <= (boundary[a] ? rim_floor : 3) || valence[b] <= (boundary[b] ? rim_floor : 3)) continue;
       // A rim vertex with too few triangles forces a near-flat angle into them: weigh the
       // rim three times.
       auto dev = [&](int v, int delta) {
@@ -91,7 +126,7 @@ int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F) {
   return flips;
 }
 
-BaseMesh build_base_mesh(const Parameterization& param, int n0) {
+BaseMesh build_base_mesh(const Parameterization& param, int n0, int rim_min_triangles) {
   const TriMesh& mesh = param.surface;
   const int n = mesh.num_vertices();
   n0 = std::min(n0, n);
@@ -144,35 +179,28 @@ BaseMesh build_base_mesh(const Parameterization& param, int n0) {
     farthest_points(mesh.V, all, n0 - 1, dist, base.samples);
   }
 
-  const int m = static_cast<int>(base.samples.size());
-  base.domain.resize(m, 3);
-  for (int i = 0; i < m; ++i) base.domain.row(i) = param.domain.row(base.samples[i]);
-
-  if (param.kind == DomainKind::sphere) {
-    base.faces = convex_hull_faces(base.domain);
-  } else {
-    const std::vector<bool> boundary = boundary_vertices(mesh.F, n);
-    RowMatrixX3d lifted(m, 3);
-    for (int i = 0; i < m; ++i) {
-      if (boundary[base.samples[i]]) base.domain.row(i) = project_to_domain(DomainKind::disk, base.domain.row(i), true);
-      lifted.row(i) << base.domain(i, 0), base.domain(i, 1), base.domain(i, 0) * base.domain(i, 0) + base.domain(i, 1) * base.domain(i, 1);
-    }
-    const RowMatrixX3i hull = convex_hull_faces(lifted);
-    std::vector<Eigen::RowVector3i> lower;
-    for (int f = 0; f < hull.rows(); ++f) {
-      const Eigen::Vector3d a = lifted.row(hull(f, 0)), b = lifted.row(hull(f, 1)), c = lifted.row(hull(f, 2));
-      if ((b - a).cross(c - a).z() < 0) lower.emplace_back(hull(f, 0), hull(f, 2), hull(f, 1));
-    }
-    base.faces.resize(static_cast<int>(lower.size()), 3);
-    for (std::size_t i = 0; i < lower.size(); ++i) base.faces.row(static_cast<int>(i)) = lower[i];
+  // Triangulates the samples in D, then flips toward regular valences. With a disk, a rim
+  // sample left with fewer than rim_min_triangles triangles is dropped and the rest
+  // triangulated again: with 2, its corners stay obtuse (~120 degrees in 3D) at every level.
+  const std::vector<bool> input_boundary =
+      param.kind == DomainKind::disk ? boundary_vertices(mesh.F, n) : std::vector<bool>(n, false);
+  for (int attempt = 0;; ++attempt) {
+    triangulate_samples(param, input_boundary, rim_min_triangles, base);
+    if (param.kind != DomainKind::disk || attempt == 4) break;
+    const int m = static_cast<int>(base.samples.size());
+    std::vector<int> triangles(m, 0);
+    for (int f = 0; f < base.faces.rows(); ++f)
+      for (int k = 0; k < 3; ++k) ++triangles[base.faces(f, k)];
+    const std::vector<bool> rim = boundary_vertices(base.faces, m);
+    std::vector<int> kept;
+    for (int i = 0; i < m; ++i)
+      if (!(rim[i] && triangles[i] < rim_min_triangles)) kept.push_back(base.samples[i]);
+    const int rim_count = static_cast<int>(std::count(rim.begin(), rim.end(), true));
+    const int dropped = m - static_cast<int>(kept.size());
+    if (dropped == 0 || rim_count - dropped < 3) break;
+    base.samples = kept;
+    base.dropped_rim_samples += dropped;
   }
-  std::set<int> used(base.faces.data(), base.faces.data() + base.faces.size());
-  if (static_cast<int>(used.size()) != m)
-    throw AlgorithmError("the base mesh does not use all of its " + std::to_string(m) +
-                         " vertices; the parameterization is too distorted for this base size (try another --faces)");
-  if (const int flipped = count_flipped(base.domain, base.faces); flipped > 0)
-    throw AlgorithmError("the base mesh has " + std::to_string(flipped) + " flipped triangles in the domain");
-  base.valence_flips = flip_toward_regular_valence(base.domain, base.faces);
   return base;
 }
 

@@ -16,15 +16,20 @@ struct BaseMesh {
   RowMatrixX3d domain;         ///< n0 rows: base vertex positions in D
   std::vector<int> samples;    ///< the vertex of the parameterized surface under each base vertex
   int valence_flips = 0;       ///< edge flips made to even out valences
+  int dropped_rim_samples = 0; ///< disk rim samples dropped because they had only 2 triangles
 };
 
+/// With a disk, rim samples left with fewer than rim_min_triangles triangles are dropped and
+/// the rest triangulated again (up to 4 times), so the result may have fewer than n0 vertices.
 /// \pre param comes from parameterize(); n0 >= 6.
 /// \throw AlgorithmError if no valid base triangulation results.
-BaseMesh build_base_mesh(const Parameterization& param, int n0);
+BaseMesh build_base_mesh(const Parameterization& param, int n0, int rim_min_triangles = 3);
 
 /// Flips edges (never boundary edges, never making a flipped triangle in D or a duplicate
-/// edge) while that lowers sum (valence - 6)² (boundary: 3·(valence - 4)²).
+/// edge, never leaving an interior vertex with valence < 3 or a boundary vertex with fewer
+/// than rim_min_triangles triangles) while that lowers sum (valence - 6)² (boundary:
+/// 3·(valence - 4)²).
 /// \return the number of flips made.
-int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F);
+int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F, int rim_min_triangles = 3);
 
 }  // namespace mrsnake

@@ -18,6 +18,7 @@
 #include "remesh/shape_smoothing.h"
 #include "remesh/simplify.h"
 #include "remesh/sizing.h"
+#include "remesh/triangle_repair.h"
 #include "mesh/topology.h"
 
 namespace mrsnake {
@@ -56,6 +57,12 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   if (options.levels == 0 && options.target_faces < 16) throw std::invalid_argument("target_faces must be at least 16");
   if (options.lloyd_iterations < 0) throw std::invalid_argument("lloyd_iterations must be >= 0");
   if (options.shape_iterations < 0) throw std::invalid_argument("shape_iterations must be >= 0");
+  if (options.repair_sweeps < 0) throw std::invalid_argument("repair_sweeps must be >= 0");
+  if (!(options.repair_threshold > 0 && options.repair_threshold <= 1))
+    throw std::invalid_argument("repair_threshold must be in (0, 1]");
+  if (!(options.repair_error_tolerance >= 0)) throw std::invalid_argument("repair_error_tolerance must be >= 0");
+  if (options.rim_min_triangles < 1 || options.rim_min_triangles > 3)
+    throw std::invalid_argument("rim_min_triangles must be in [1, 3]");
   if (options.base_vertices < 6) throw std::invalid_argument("base_vertices must be at least 6");
   if (!(options.density_exponent >= 0 && options.density_exponent <= 8))
     throw std::invalid_argument("density_exponent must be in [0, 8]");
@@ -97,12 +104,13 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
 
   const auto base_start = Clock::now();
   report(options.progress, "base mesh", 0);
-  const BaseMesh base = build_base_mesh(param, n0);
+  const BaseMesh base = build_base_mesh(param, n0, options.rim_min_triangles);
   n0 = static_cast<int>(base.domain.rows());
   result.connectivity = subdivide_connectivity(base.faces, n0, levels);
   result.parameterization["base_vertices"] = n0;
   result.parameterization["base_faces"] = base.faces.rows();
   result.parameterization["base_valence_flips"] = base.valence_flips;
+  result.parameterization["base_dropped_rim_samples"] = base.dropped_rim_samples;
 
   const DomainMesh domain_mesh(param.domain, param.surface.F);
   Eigen::VectorXd wanted = Eigen::VectorXd::Ones(param.surface.num_vertices());  // wanted 3D point density
@@ -169,6 +177,15 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       }
       level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
     }
+    TriangleRepairStats repair;
+    if (options.relax == RelaxMode::all_vertices && options.repair_sweeps > 0 && (options.repair_coarse_levels || j == levels)) {
+      TriangleRepairOptions repair_options;
+      repair_options.sweeps = options.repair_sweeps;
+      repair_options.threshold = options.repair_threshold;
+      repair_options.guard_surface_error = options.repair_guard_finest && j == levels;
+      repair_options.error_tolerance = options.repair_error_tolerance;
+      repair = repair_worst_triangles(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, repair_options);
+    }
     report(options.progress, "level " + std::to_string(j), 0.5);
     if (reproject)
       parallel_ranges(static_cast<std::size_t>(level.positions.rows()), [&](std::size_t begin, std::size_t end) {
@@ -192,6 +209,11 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     s["lloyd_rejected_moves"] = relax_stats.rejected_moves;
     s["lloyd_last_mean_shift"] = relax_stats.mean_shift;
     s["shape_moves"] = shape_moves;
+    s["repair_moves"] = repair.moves;
+    if (repair.moves > 0) {
+      s["repair_q_min_before"] = repair.q_min_before;
+      s["repair_q_min_after"] = repair.q_min_after;
+    }
     if (options.compute_stats) {
       const TriMesh mesh{level.positions, F};
       s["quality"] = mesh_quality(mesh);
@@ -220,6 +242,12 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["curvature_weight"] = options.curvature_weight;
   j["lloyd_iterations"] = options.lloyd_iterations;
   j["shape_iterations"] = options.relax == RelaxMode::all_vertices ? options.shape_iterations : 0;
+  j["repair_sweeps"] = options.relax == RelaxMode::all_vertices ? options.repair_sweeps : 0;
+  j["repair_threshold"] = options.repair_threshold;
+  j["repair_coarse_levels"] = options.repair_coarse_levels;
+  j["repair_guard_finest"] = options.repair_guard_finest;
+  j["repair_error_tolerance"] = options.repair_error_tolerance;
+  j["rim_min_triangles"] = options.rim_min_triangles;
   j["parameterization"] = result.parameterization;
   double total = result.parameterization.value("seconds", 0.0);
   nlohmann::json per_level = nlohmann::json::array();

@@ -47,6 +47,22 @@ struct RemeshOptions {
   /// triangles, moved in D (remesh/shape_smoothing.h). The Lloyd step evens out sizes but is
   /// affine invariant, so it cannot repair shear; this can. 0 = the Lloyd step alone.
   int shape_iterations = 3;
+  /// With all_vertices: sweeps per level of the final repair of the worst triangles
+  /// (remesh/triangle_repair.h): vertices of triangles with Q < repair_threshold move
+  /// tangentially, on the input, only when that raises the smallest Q around them. 0 = off.
+  int repair_sweeps = 6;
+  double repair_threshold = 0.8;
+  /// Repair every level (true) or only the finest (false; coarse levels keep the Lloyd layout).
+  bool repair_coarse_levels = true;
+  /// On the finest level, refuse repair moves that take triangles further from the surface
+  /// (TriangleRepairOptions::guard_surface_error): the finest level is what is measured
+  /// against the input; coarse levels only shape the layout.
+  bool repair_guard_finest = true;
+  /// The guard lets triangles move away from the surface by up to this x the mean edge length.
+  double repair_error_tolerance = 0.03;
+  /// Disk inputs: a base rim vertex with fewer triangles than this is dropped from the base
+  /// mesh (remesh/base_mesh.h); with 2 its corners stay obtuse at every level. 1 = keep all.
+  int rim_min_triangles = 3;
   /// Inputs with more faces than max(simplify_above_faces, 8 x the finest level's faces) are
   /// simplified to that size before parameterization (remesh/simplify.h); the result is then
   /// projected back onto the original input. 0 = never simplify.

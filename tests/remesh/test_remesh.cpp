@@ -14,11 +14,14 @@
 #include "mesh/primitives.h"
 #include "mesh/quality.h"
 #include "mesh/topology.h"
+#include "remesh/base_mesh.h"
 #include "remesh/domain.h"
+#include "remesh/lift.h"
 #include "remesh/lloyd.h"
 #include "remesh/parameterization.h"
 #include "remesh/remesh.h"
 #include "remesh/sizing.h"
+#include "remesh/triangle_repair.h"
 #include "tests/test_support.h"
 
 namespace mrsnake {
@@ -295,6 +298,158 @@ TEST(Lloyd, CellStaysInsideANonConvexOneRing) {
   EXPECT_GT(stats.moves, 0);
   // Converged to its own cell's centroid.
   EXPECT_LT((lloyd_cell_centroid(G, W, 6) - Eigen::Vector3d(W.row(6))).norm(), 1e-6);
+}
+
+// The final repair: on an ellipsoid's parameterization, a triangulation of D with a few
+// vertices pushed toward a neighbour (sliver triangles in 3D) is repaired in place: the
+// smallest Q goes up a lot, nothing flips in D, and every vertex is still the exact lift of
+// its domain position (so on the surface).
+TEST(TriangleRepair, RaisesTheWorstQualityOnTheSurfaceWithoutFlips) {
+  const TriMesh input = ellipsoid(4);
+  const Parameterization param = parameterize(input);
+  const DomainMesh domain(param.domain, param.surface.F);
+  TriMesh grid = icosphere(3);
+  RowMatrixX3d U = grid.V.rowwise().normalized();
+  const RowMatrixX3i& F = grid.F;
+  ASSERT_EQ(count_flipped(U, F), 0);
+  // Push 10 vertices 80% of the way toward a neighbour; keep only pushes that flip nothing.
+  for (int f = 0; f < 300; f += 30) {
+    const int v = F(f, 0), w = F(f, 1);
+    const Eigen::RowVector3d before = U.row(v);
+    U.row(v) = (0.2 * U.row(v) + 0.8 * U.row(w)).normalized();
+    if (count_flipped(U, F) > 0) U.row(v) = before;
+  }
+  std::vector<int> hints(U.rows(), 0);
+  RowMatrixX3d X = lift_to_surface(domain, param.surface.V, U, hints);
+  const double q_before = mesh_quality(TriMesh{X, F}).q_min;
+  ASSERT_LT(q_before, 0.3);
+  const TriangleRepairStats stats =
+      repair_worst_triangles(DomainKind::sphere, F, domain, param.surface.V, U, X, hints, TriangleRepairOptions{});
+  const double q_after = mesh_quality(TriMesh{X, F}).q_min;
+  EXPECT_GT(stats.moves, 0);
+  EXPECT_NEAR(stats.q_min_before, q_before, 1e-12);
+  EXPECT_NEAR(stats.q_min_after, q_after, 1e-12);
+  EXPECT_GT(q_after, 0.5);
+  EXPECT_EQ(count_flipped(U, F), 0);
+  for (int v = 0; v < U.rows(); ++v) EXPECT_NEAR(U.row(v).norm(), 1.0, 1e-12);
+  std::vector<int> fresh(U.rows(), 0);
+  EXPECT_LT((lift_to_surface(domain, param.surface.V, U, fresh) - X).cwiseAbs().maxCoeff(), 1e-9);
+  const SurfaceLocator locator(input);
+  EXPECT_LT(locator.distances(X).maxCoeff(), 1e-9 * bounding_box_diagonal(input.V));
+}
+
+// With the surface-error guard (and no tolerance) no edge leaves the surface further than
+// before: the largest distance between an edge's 3D midpoint and the lift of its midpoint in
+// D cannot grow, since a move only changes the moved vertex's edges and must keep them within
+// the old largest. The guard does refuse moves that the unguarded repair makes.
+TEST(TriangleRepair, GuardKeepsEdgesAsCloseToTheSurface) {
+  const TriMesh input = ellipsoid(4);
+  const Parameterization param = parameterize(input);
+  const DomainMesh domain(param.domain, param.surface.F);
+  const TriMesh grid = icosphere(3);
+  RowMatrixX3d U0 = grid.V.rowwise().normalized();
+  const RowMatrixX3i& F = grid.F;
+  {
+    // Slivers at the most curved places (the ends of the long axis), where moves cut most.
+    std::vector<int> hints(U0.rows(), 0);
+    const RowMatrixX3d X0 = lift_to_surface(domain, param.surface.V, U0, hints);
+    for (int f = 0; f < F.rows(); ++f) {
+      const int v = F(f, 0), w = F(f, 1);
+      if (std::abs(X0(v, 0)) < 2.0) continue;
+      const Eigen::RowVector3d before = U0.row(v);
+      U0.row(v) = (0.5 * U0.row(v) + 0.5 * U0.row(w)).normalized();
+      if (count_flipped(U0, F) > 0) U0.row(v) = before;
+    }
+  }
+  auto largest_edge_error = [&](const RowMatrixX3d& U, const RowMatrixX3d& X) {
+    double error = 0;
+    int hint = 0;
+    for (const auto& [a, b] : edges_of(F)) {
+      const Eigen::Vector3d mid = (U.row(a) + U.row(b)).normalized().transpose();
+      const DomainMesh::Location loc = domain.locate(mid, hint);
+      hint = loc.face;
+      Eigen::Vector3d lifted = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 3; ++k) lifted += loc.barycentric[k] * param.surface.V.row(domain.faces()(loc.face, k)).transpose();
+      error = std::max(error, (lifted - 0.5 * (X.row(a) + X.row(b)).transpose()).norm());
+    }
+    return error;
+  };
+  std::vector<double> after(2);
+  std::vector<int> moves(2);
+  double before = 0;
+  for (bool guard : {true, false}) {
+    RowMatrixX3d U = U0;
+    std::vector<int> hints(U.rows(), 0);
+    RowMatrixX3d X = lift_to_surface(domain, param.surface.V, U, hints);
+    before = largest_edge_error(U, X);
+    TriangleRepairOptions options;
+    options.guard_surface_error = guard;
+    options.error_tolerance = 0;
+    const TriangleRepairStats stats = repair_worst_triangles(DomainKind::sphere, F, domain, param.surface.V, U, X, hints, options);
+    EXPECT_GT(stats.moves, 0);
+    EXPECT_GT(stats.q_min_after, stats.q_min_before);
+    after[guard ? 0 : 1] = largest_edge_error(U, X);
+    moves[guard ? 0 : 1] = stats.moves;
+  }
+  EXPECT_LE(after[0], before * (1 + 1e-9));
+  EXPECT_LT(moves[0], moves[1]);
+}
+
+// With repair on, every level's smallest Q is at least what it was before that level's repair
+// (on a disk, rim vertices slide along the circle and stay on it; on a sphere), every level
+// meets the angle targets, and the finest level beats the same run with repair off.
+TEST(TriangleRepair, RaisesEveryLevelsWorstTriangleAndKeepsTheRimOnTheCircle) {
+  for (const TriMesh& input : {spherical_cap(4), ellipsoid(4)}) {
+    RemeshOptions on = small_options(3, 24);
+    on.compute_stats = true;
+    RemeshOptions off = on;
+    off.repair_sweeps = 0;
+    const RemeshResult a = remesh(input, on), b = remesh(input, off);
+    expect_nested_and_valid(a, input, a.domain == "sphere");
+    int moves = 0;
+    for (int j = 0; j <= 3; ++j) {
+      SCOPED_TRACE("level " + std::to_string(j));
+      const auto& s = a.levels[j].stats;
+      moves += s["repair_moves"].get<int>();
+      EXPECT_EQ(b.levels[j].stats["repair_moves"].get<int>(), 0);
+      if (s["repair_moves"].get<int>() > 0) {
+        EXPECT_GT(s["repair_q_min_after"].get<double>(), s["repair_q_min_before"].get<double>());
+        EXPECT_NEAR(s["repair_q_min_after"].get<double>(), s["quality"]["q_min"].get<double>(), 1e-12);
+      }
+      EXPECT_GE(s["quality"]["q_min"].get<double>(), 0.6);
+      EXPECT_GE(s["quality"]["min_angle_deg"].get<double>(), 30.0);
+    }
+    EXPECT_GT(moves, 0);
+    EXPECT_GT(a.levels[3].stats["quality"]["q_min"].get<double>(), b.levels[3].stats["quality"]["q_min"].get<double>());
+  }
+}
+
+// Rim vertices of a disk's base mesh with only 2 triangles are dropped: on the mushroom the
+// old rule leaves some (their corners are ~120 degrees at every level), the new none.
+TEST(RemeshData, MushroomBaseRimVerticesHaveThreeTriangles) {
+  MRSNAKE_REQUIRE_DATA(path, "meshes/mushroom.off");
+  const Parameterization param = parameterize(read_mesh(path));
+  auto thin_rim_vertices = [](const BaseMesh& base) {
+    const int m = static_cast<int>(base.domain.rows());
+    std::vector<int> triangles(m, 0);
+    for (int f = 0; f < base.faces.rows(); ++f)
+      for (int k = 0; k < 3; ++k) ++triangles[base.faces(f, k)];
+    const std::vector<bool> rim = boundary_vertices(base.faces, m);
+    int thin = 0;
+    for (int v = 0; v < m; ++v) thin += rim[v] && triangles[v] < 3;
+    return thin;
+  };
+  int old_thin = 0;
+  for (int n0 : {66, 127, 252}) {
+    SCOPED_TRACE(n0);
+    old_thin += thin_rim_vertices(build_base_mesh(param, n0, 1));
+    const BaseMesh base = build_base_mesh(param, n0, 3);
+    EXPECT_EQ(thin_rim_vertices(base), 0);
+    EXPECT_EQ(count_flipped(base.domain, base.faces), 0);
+    EXPECT_GT(base.domain.rows(), n0 * 9 / 10);
+    EXPECT_EQ(static_cast<int>(base.domain.rows()) + base.dropped_rim_samples, n0);
+  }
+  EXPECT_GT(old_thin, 0);
 }
 
 // Real meshes: zero flipped triangles at every level (kept small for a fast suite).

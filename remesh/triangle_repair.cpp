@@ -1,0 +1,212 @@
+#include "remesh/triangle_repair.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include <Eigen/Dense>
+
+#include "mesh/quality.h"
+
+namespace mrsnake {
+namespace {
+
+// Distance from p to the triangle (a, b, c) (Ericson, Real-Time Collision Detection, 5.1.5).
+double point_triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                               const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return ap.norm();
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return bp.norm();
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (p - (a + d1 / (d1 - d3) * ab)).norm();
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return cp.norm();
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + d2 / (d2 - d6) * ac)).norm();
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return (p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
+  const double denom = 1.0 / (va + vb + vc);
+  return (p - (a + ab * (vb * denom) + ac * (vc * denom))).norm();
+}
+
+}  // namespace
+
+TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& F, const DomainMesh& param,
+                                           const RowMatrixX3d& surface_V, RowMatrixX3d& U, RowMatrixX3d& X,
+                                           std::vector<int>& hints, const TriangleRepairOptions& options) {
+  const int n = static_cast<int>(U.rows());
+  const int m = static_cast<int>(F.rows());
+  const std::vector<bool> boundary = kind == DomainKind::disk ? boundary_vertices(F, n) : std::vector<bool>(n, false);
+  std::vector<int> offset(n + 1, 0), star;
+  for (int f = 0; f < m; ++f)
+    for (int k = 0; k < 3; ++k) ++offset[F(f, k) + 1];
+  for (int v = 0; v < n; ++v) offset[v + 1] += offset[v];
+  star.resize(offset[n]);
+  {
+    std::vector<int> fill(offset.begin(), offset.end() - 1);
+    for (int f = 0; f < m; ++f)
+      for (int k = 0; k < 3; ++k) star[fill[F(f, k)]++] = f;
+  }
+  const auto& PF = param.faces();
+  const auto& PD = param.positions();
+  auto quality = [&](int f, int v, const Eigen::Vector3d& x) {
+    Eigen::Vector3d P[3] = {X.row(F(f, 0)), X.row(F(f, 1)), X.row(F(f, 2))};
+    for (int k = 0; k < 3; ++k)
+      if (F(f, k) == v) P[k] = x;
+    return frey_borouchaki_quality(P[0], P[1], P[2]);
+  };
+  // Smallest Q of v's triangles with v at x.
+  auto star_quality = [&](int v, const Eigen::Vector3d& x) {
+    double q = std::numeric_limits<double>::infinity();
+    for (int i = offset[v]; i < offset[v + 1]; ++i) q = std::min(q, quality(star[i], v, x));
+    return q;
+  };
+  auto unflipped_in_domain = [&](int v, const Eigen::Vector3d& u) {
+    for (int i = offset[v]; i < offset[v + 1]; ++i) {
+      const int f = star[i];
+      Eigen::Vector3d P[3] = {U.row(F(f, 0)), U.row(F(f, 1)), U.row(F(f, 2))};
+      for (int k = 0; k < 3; ++k)
+        if (F(f, k) == v) P[k] = u;
+      if (!(domain_orientation(P[0], P[1], P[2]) > 0)) return false;
+    }
+    return true;
+  };
+  auto lift = [&](const Eigen::Vector3d& u, int& hint) {
+    const DomainMesh::Location loc = param.locate(u, hint);
+    hint = loc.face;
+    return Eigen::Vector3d(loc.barycentric[0] * surface_V.row(PF(loc.face, 0)).transpose() +
+                           loc.barycentric[1] * surface_V.row(PF(loc.face, 1)).transpose() +
+                           loc.barycentric[2] * surface_V.row(PF(loc.face, 2)).transpose());
+  };
+  // How far v's triangles (v at u in D, x in 3D) leave the surface: the largest distance
+  // between an edge's 3D midpoint and the lift of its midpoint in D, and (with `old` = v's
+  // position before the move, on the surface) the distance from `old` to the triangles: a
+  // move off a ridge or a tip leaves it away from them.
+  auto surface_error = [&](int v, const Eigen::Vector3d& u, const Eigen::Vector3d& x, const Eigen::Vector3d& old) {
+    double error = 0, to_old = std::numeric_limits<double>::infinity();
+    int hint = hints[v];
+    for (int i = offset[v]; i < offset[v + 1]; ++i) {
+      const int f = star[i];
+      int k = 0;
+      while (F(f, k) != v) ++k;
+      const int a = F(f, (k + 1) % 3), b = F(f, (k + 2) % 3);
+      for (int w : {a, b}) {
+        const Eigen::Vector3d mid = project_to_domain(kind, 0.5 * (u + U.row(w).transpose()), false);
+        error = std::max(error, (lift(mid, hint) - 0.5 * (x + X.row(w).transpose())).norm());
+      }
+      to_old = std::min(to_old, point_triangle_distance(old, x, X.row(a).transpose(), X.row(b).transpose()));
+    }
+    return std::max(error, to_old);
+  };
+  double mean_edge = 0;
+  for (int f = 0; f < m; ++f)
+    for (int k = 0; k < 3; ++k) mean_edge += (X.row(F(f, k)) - X.row(F(f, (k + 1) % 3))).norm();
+  mean_edge /= std::max(1, 3 * m);
+  auto smallest_q = [&]() {
+    double q = std::numeric_limits<double>::infinity();
+    for (int f = 0; f < m; ++f) q = std::min(q, quality(f, -1, Eigen::Vector3d::Zero()));
+    return m > 0 ? q : 0.0;
+  };
+
+  TriangleRepairStats stats;
+  stats.q_min_before = smallest_q();
+  std::vector<std::pair<double, int>> poor;
+  std::vector<int> visited(n, -1);
+  for (int sweep = 0; sweep < options.sweeps; ++sweep) {
+    poor.clear();
+    for (int f = 0; f < m; ++f)
+      if (const double q = quality(f, -1, Eigen::Vector3d::Zero()); q < options.threshold) poor.emplace_back(q, f);
+    if (poor.empty()) break;
+    std::sort(poor.begin(), poor.end());
+    int moved = 0;
+    for (const auto& [q_face, face] : poor)
+      for (int corner = 0; corner < 3; ++corner) {
+        const int v = F(face, corner);
+        if (visited[v] == sweep || (boundary[v] && !options.move_rim)) continue;
+        visited[v] = sweep;
+        const Eigen::Vector3d x = X.row(v);
+        const double current = star_quality(v, x);
+        if (!(current < options.threshold)) continue;
+        Eigen::Vector3d normal = Eigen::Vector3d::Zero(), centroid = Eigen::Vector3d::Zero(), mean_apex = Eigen::Vector3d::Zero();
+        Eigen::Vector3d worst_apex = x;
+        double worst = std::numeric_limits<double>::infinity();
+        for (int i = offset[v]; i < offset[v + 1]; ++i) {
+          const int f = star[i];
+          normal += (X.row(F(f, 1)) - X.row(F(f, 0))).cross(X.row(F(f, 2)) - X.row(F(f, 0))).transpose();
+        }
+        if (!(normal.norm() > 0)) continue;
+        normal.normalize();
+        int count = 0;
+        for (int i = offset[v]; i < offset[v + 1]; ++i) {
+          const int f = star[i];
+          int k = 0;
+          while (F(f, k) != v) ++k;
+          const Eigen::Vector3d a = X.row(F(f, (k + 1) % 3)), b = X.row(F(f, (k + 2) % 3));
+          const Eigen::Vector3d side = normal.cross(b - a);  // v lies left of a -> b, seen from outside
+          if (!(side.norm() > 0)) continue;
+          const Eigen::Vector3d apex = 0.5 * (a + b) + (std::sqrt(3.0) / 2.0) * (b - a).norm() * side.normalized();
+          mean_apex += apex;
+          centroid += 0.5 * (a + b);  // each neighbour twice around an interior vertex
+          ++count;
+          if (const double qf = quality(f, -1, Eigen::Vector3d::Zero()); qf < worst) {
+            worst = qf;
+            worst_apex = apex;
+          }
+        }
+        if (count == 0) continue;
+        const Eigen::Vector3d targets[3] = {worst_apex, mean_apex / count, centroid / count};
+        // The affine map of the input triangle under v pulls a 3D move back to D.
+        const int pf = hints[v];
+        const Eigen::Vector3d x0 = surface_V.row(PF(pf, 0)), d0 = PD.row(PF(pf, 0));
+        Eigen::Matrix<double, 3, 2> XE, DE;
+        XE.col(0) = surface_V.row(PF(pf, 1)).transpose() - x0;
+        XE.col(1) = surface_V.row(PF(pf, 2)).transpose() - x0;
+        DE.col(0) = PD.row(PF(pf, 1)).transpose() - d0;
+        DE.col(1) = PD.row(PF(pf, 2)).transpose() - d0;
+        const Eigen::Matrix2d gram = XE.transpose() * XE;
+        if (!(std::abs(gram.determinant()) > 0)) continue;
+        const Eigen::LDLT<Eigen::Matrix2d> solver(gram);
+        const Eigen::Vector3d u = U.row(v);
+        const double allowed_error =
+            options.guard_surface_error ? std::max(surface_error(v, u, x, x), options.error_tolerance * mean_edge) : 0.0;
+        double best = current;
+        Eigen::Vector3d best_u = u, best_x = x;
+        int best_hint = hints[v];
+        for (const Eigen::Vector3d& target : targets) {
+          Eigen::Vector3d move = target - x;
+          move -= move.dot(normal) * normal;
+          const Eigen::Vector3d domain_move = DE * solver.solve(XE.transpose() * move);
+          for (double t : {1.0, 0.5, 0.25}) {
+            const Eigen::Vector3d candidate = project_to_domain(kind, u + t * domain_move, boundary[v]);
+            if (!unflipped_in_domain(v, candidate)) continue;
+            int hint = hints[v];
+            const Eigen::Vector3d lifted = lift(candidate, hint);
+            const double q = star_quality(v, lifted);
+            if (!(q > best + 1e-9)) continue;
+            if (options.guard_surface_error && surface_error(v, candidate, lifted, x) > allowed_error) continue;
+            best = q;
+            best_u = candidate;
+            best_x = lifted;
+            best_hint = hint;
+          }
+        }
+        if (!(best > current + 1e-9)) continue;
+        U.row(v) = best_u.transpose();
+        X.row(v) = best_x.transpose();
+        hints[v] = best_hint;
+        ++moved;
+      }
+    stats.moves += moved;
+    if (moved == 0) break;
+  }
+  stats.q_min_after = smallest_q();
+  return stats;
+}
+
+}  // namespace mrsnake

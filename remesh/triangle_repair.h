@@ -1,0 +1,52 @@
+#pragma once
+/// \file triangle_repair.h
+/// A final per-level repair of the worst triangles, in 3D, with the vertices kept on the input.
+///
+/// Lloyd and shape smoothing work on averages, so a few triangles stay poor where the
+/// parameterization's stretch changes fast or around extraordinary base vertices. This step
+/// looks only at the vertices of triangles whose Frey–Borouchaki quality Q is below a
+/// threshold and, worst first, tries a few tangential 3D moves (toward the apex that makes its
+/// worst triangle equilateral, toward the mean such apex, toward the 1-ring centroid; full,
+/// half and quarter steps). Each move is pulled back to D through the Jacobian of the input
+/// triangle under the vertex and re-lifted exactly (so the vertex stays on the input surface);
+/// the candidate that raises the smallest Q of the vertex's triangles the most is kept, and
+/// only if it raises it. Connectivity is untouched (the hierarchy stays nested) and a move that
+/// would flip a triangle in D is never taken. Disk rim vertices slide along the circle.
+#include <vector>
+
+#include "mesh/trimesh.h"
+#include "remesh/domain.h"
+
+namespace mrsnake {
+
+struct TriangleRepairOptions {
+  int sweeps = 6;            ///< passes over the poor triangles (each recomputes which are poor)
+  double threshold = 0.8;    ///< triangles with Q below this are repaired
+  bool move_rim = true;      ///< disk rim vertices may slide along the boundary
+  /// Refuse moves that take the vertex's triangles further from the surface than before, or
+  /// than error_tolerance x the mean edge length if that is more (largest distance between an
+  /// edge's 3D midpoint and the lift of its midpoint in D, and from the vertex's old position
+  /// to its new triangles): better shapes must not cut across ridges or tips.
+  bool guard_surface_error = false;
+  double error_tolerance = 0.03;
+};
+
+struct TriangleRepairStats {
+  int moves = 0;           ///< vertex moves made
+  double q_min_before = 0; ///< smallest Q in 3D before the repair
+  double q_min_after = 0;  ///< and after
+};
+
+/// Repairs the worst triangles of (X, F) by moving vertices tangentially; updates U, X and hints.
+/// \pre X = lift of U onto the surface whose domain mesh is `param` (3D positions surface_V);
+///      no triangle of (U, F) flipped in D; hints has one face of `param` per vertex.
+/// \post no triangle of (U, F) is flipped in D; the smallest Q of every moved vertex's
+///       triangles went up, so the mesh's smallest Q never goes down; with
+///       guard_surface_error and error_tolerance 0 the largest edge-midpoint distance to the
+///       surface never goes up either.
+/// \throw nothing (a vertex whose move cannot be computed stays put).
+TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& F, const DomainMesh& param,
+                                           const RowMatrixX3d& surface_V, RowMatrixX3d& U, RowMatrixX3d& X,
+                                           std::vector<int>& hints, const TriangleRepairOptions& options);
+
+}  // namespace mrsnake
