@@ -3,6 +3,8 @@
 /// Distances between surfaces and closest-point queries (CGAL AABB tree behind a small
 /// adapter: no CGAL type crosses this header).
 #include <memory>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -57,6 +59,11 @@ SurfaceDistance surface_distance(const TriMesh& mesh, const TriMesh& reference, 
 /// \throw TopologyError if a face makes the mesh non-manifold or inconsistently oriented
 ///        (CGAL's halfedge mesh cannot hold it).
 int count_self_intersections(const TriMesh& mesh);
+
+/// The pairs of faces (indices into mesh.F, first < second) that intersect, as
+/// count_self_intersections counts them.
+/// \throw TopologyError as count_self_intersections does.
+std::vector<std::pair<int, int>> self_intersecting_face_pairs(const TriMesh& mesh);
 
 void to_json(nlohmann::json& j, const SurfaceDistance& d);
 

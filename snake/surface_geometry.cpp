@@ -82,4 +82,22 @@ void smooth_on_rings(const VertexRings& rings, Eigen::VectorXd& values, int pass
   }
 }
 
+void median_on_rings(const VertexRings& rings, Eigen::VectorXd& values, int passes) {
+  Eigen::VectorXd tmp(values.size());
+  std::vector<double> window;
+  for (int p = 0; p < passes; ++p) {
+    for (int v = 0; v < rings.num_vertices(); ++v) {
+      window.assign(1, values[v]);
+      for (int k = rings.offsets[v]; k < rings.offsets[v + 1]; ++k) window.push_back(values[rings.neighbors[k]]);
+      const std::size_t mid = window.size() / 2;
+      std::nth_element(window.begin(), window.begin() + static_cast<long>(mid), window.end());
+      double m = window[mid];
+      if (window.size() % 2 == 0)  // the mean of the two middle values
+        m = 0.5 * (m + *std::max_element(window.begin(), window.begin() + static_cast<long>(mid)));
+      tmp[v] = m;
+    }
+    values.swap(tmp);
+  }
+}
+
 }  // namespace mrsnake
