@@ -224,13 +224,15 @@ SnakeLevelReport DeformableSurface::run(RowMatrixX3d& V, const ExternalSearch& s
   return report;
 }
 
-int undo_self_intersections(RowMatrixX3d& V, const RowMatrixX3d& safe, const RowMatrixX3i& F, const VertexRings& rings,
-                            int max_rounds) {
+UndoOutcome undo_self_intersections(RowMatrixX3d& V, const RowMatrixX3d& safe, const RowMatrixX3i& F,
+                                    const VertexRings& rings, int max_rounds) {
   const int n = static_cast<int>(V.rows());
   std::vector<char> moved(static_cast<std::size_t>(n), 0), flagged(static_cast<std::size_t>(n));
-  for (int round = 0; round < max_rounds; ++round) {
+  UndoOutcome out;
+  for (int round = 0;; ++round) {
     const auto pairs = self_intersecting_face_pairs(TriMesh{V, F});
-    if (pairs.empty()) break;
+    out.remaining_pairs = static_cast<int>(pairs.size());
+    if (pairs.empty() || round == max_rounds) break;
     std::fill(flagged.begin(), flagged.end(), 0);
     for (const auto& [f, g] : pairs)
       for (const int face : {f, g})
@@ -247,7 +249,8 @@ int undo_self_intersections(RowMatrixX3d& V, const RowMatrixX3d& safe, const Row
         moved[v] = 1;
       }
   }
-  return static_cast<int>(std::count(moved.begin(), moved.end(), 1));
+  out.moved_vertices = static_cast<int>(std::count(moved.begin(), moved.end(), 1));
+  return out;
 }
 
 }  // namespace mrsnake

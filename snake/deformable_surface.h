@@ -88,13 +88,19 @@ struct TangentialPrior {
 /// \pre model_V has rings.num_vertices() rows.
 TangentialPrior tangential_prior(const VertexRings& rings, const RowMatrixX3i& F, const RowMatrixX3d& model_V);
 
+/// What undo_self_intersections did.
+struct UndoOutcome {
+  int moved_vertices = 0;     ///< vertices moved back towards the safe positions
+  int remaining_pairs = 0;    ///< intersecting face pairs left (count_self_intersections of the result)
+};
+
 /// Undoes self-intersections: the vertices of intersecting faces, and their rings, move back
 /// towards `safe` (their displacement halved per round, then dropped), until no pair of
-/// faces intersects or `max_rounds` rounds have run. Returns the number of vertices moved.
-/// Faces that intersect in `safe` itself cannot be resolved this way and stay.
+/// faces intersects or `max_rounds` rounds have run. Faces that intersect in `safe` itself
+/// cannot be resolved this way and stay (counted in remaining_pairs).
 /// \pre V and safe have the same rows; F references them; rings built from F.
-int undo_self_intersections(RowMatrixX3d& V, const RowMatrixX3d& safe, const RowMatrixX3i& F, const VertexRings& rings,
-                            int max_rounds = 8);
+UndoOutcome undo_self_intersections(RowMatrixX3d& V, const RowMatrixX3d& safe, const RowMatrixX3i& F,
+                                    const VertexRings& rings, int max_rounds = 8);
 
 /// The snake of one level.
 class DeformableSurface {

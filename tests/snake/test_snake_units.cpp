@@ -296,15 +296,23 @@ TEST(Snake, UndoSelfIntersectionsRestoresAnIntersectionFreeSurface) {
   ASSERT_GT((m.V.row(far) - m.V.row(v)).norm(), 8.0);
   V.row(far) *= 1.02;
   ASSERT_GT(count_self_intersections(TriMesh{V, m.F}), 0);
-  const int moved = undo_self_intersections(V, m.V, m.F, rings);
+  const UndoOutcome undo = undo_self_intersections(V, m.V, m.F, rings);
   EXPECT_EQ(count_self_intersections(TriMesh{V, m.F}), 0);
-  EXPECT_GT(moved, 0);
-  EXPECT_LT(moved, m.num_vertices() / 4);
+  EXPECT_EQ(undo.remaining_pairs, 0);
+  EXPECT_GT(undo.moved_vertices, 0);
+  EXPECT_LT(undo.moved_vertices, m.num_vertices() / 4);
   EXPECT_EQ(V.row(far), (1.02 * m.V.row(far)).eval());
   // Nothing to undo on a clean surface.
   RowMatrixX3d clean = 1.1 * m.V;
-  EXPECT_EQ(undo_self_intersections(clean, m.V, m.F, rings), 0);
+  EXPECT_EQ(undo_self_intersections(clean, m.V, m.F, rings).moved_vertices, 0);
   EXPECT_EQ(clean, (1.1 * m.V).eval());
+  // An intersection already in the safe positions stays, and is counted.
+  RowMatrixX3d stuck = V;
+  stuck.row(v) = -1.3 * m.V.row(v);
+  const RowMatrixX3d unsafe = stuck;
+  const UndoOutcome left = undo_self_intersections(stuck, unsafe, m.F, rings);
+  EXPECT_EQ(left.remaining_pairs, count_self_intersections(TriMesh{unsafe, m.F}));
+  EXPECT_GT(left.remaining_pairs, 0);
 }
 
 TEST(Model, MidpointFrameSynthesisFollowsASimilarity) {
