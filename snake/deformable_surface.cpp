@@ -97,10 +97,9 @@ InternalTerms compute_internal(const VertexRings& rings, const RowMatrixX3i& F, 
       tangent_basis(V, rings, v, nv, e1, e2);
       const Eigen::Vector3d x = V.row(v).transpose();
       std::complex<double> turn = 0.0;
-      for (int k = rings.offsets[v]; k < rings.offsets[v + 1]; ++k) {
+      for (int k = rings.offsets[v]; k < rings.offsets[v + 1]; ++k) {  // longer edges weigh more
         const Eigen::Vector3d d = V.row(rings.neighbors[k]).transpose() - x;
-        const std::complex<double> z(d.dot(e1), d.dot(e2));
-        if (std::abs(z) > 0) turn += z / std::abs(z) * std::conj(tangential.ring_directions[k]);
+        turn += std::complex<double>(d.dot(e1), d.dot(e2)) * std::conj(tangential.ring_directions[k]);
       }
       const std::complex<double> target = (std::abs(turn) > 0 ? turn / std::abs(turn) : 1.0) * tangential.umbrella[v] * L[v];
       tangential_force -= target.real() * e1 + target.imag() * e2;
@@ -230,7 +229,7 @@ UndoOutcome undo_self_intersections(RowMatrixX3d& V, const RowMatrixX3d& safe, c
   std::vector<char> moved(static_cast<std::size_t>(n), 0), flagged(static_cast<std::size_t>(n));
   UndoOutcome out;
   for (int round = 0;; ++round) {
-    const auto pairs = self_intersecting_face_pairs(TriMesh{V, F});
+    const auto pairs = crossing_face_pairs(TriMesh{V, F});
     out.remaining_pairs = static_cast<int>(pairs.size());
     if (pairs.empty() || round == max_rounds) break;
     std::fill(flagged.begin(), flagged.end(), 0);

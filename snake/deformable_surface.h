@@ -91,10 +91,12 @@ TangentialPrior tangential_prior(const VertexRings& rings, const RowMatrixX3i& F
 /// What undo_self_intersections did.
 struct UndoOutcome {
   int moved_vertices = 0;     ///< vertices moved back towards the safe positions
-  int remaining_pairs = 0;    ///< intersecting face pairs left (count_self_intersections of the result)
+  int remaining_pairs = 0;    ///< crossing face pairs left (mesh/distance.h)
 };
 
-/// Undoes self-intersections: the vertices of intersecting faces, and their rings, move back
+/// Undoes self-intersections: the vertices of crossing faces (faces that share no vertex and
+/// intersect, mesh/distance.h's crossing_face_pairs; folds of neighbours are the snake's
+/// flip test's business), and their rings, move back
 /// towards `safe` (their displacement halved per round, then dropped), until no pair of
 /// faces intersects or `max_rounds` rounds have run. Faces that intersect in `safe` itself
 /// cannot be resolved this way and stay (counted in remaining_pairs).

@@ -283,7 +283,6 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
 
   // Coarse to fine.
   const auto t_levels = Clock::now();
-  int final_pairs = -1;
   for (int j = 0; j <= L; ++j) {
     const auto t_level = Clock::now();
     report(progress, "level " + std::to_string(j), static_cast<double>(j) / (L + 1));
@@ -306,12 +305,8 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     const RowMatrixX3d V_level_start = V;
     out.snake = snake.run(V, search, step, range);
     // The fold test inside the run is local; a surface can still pass through itself.
-    // At the finest level its last check is the final count (no second pass over the faces).
-    if (options.undo_self_intersections) {
-      const UndoOutcome undo = undo_self_intersections(V, V_level_start, model.faces(j), snake.rings());
-      out.rolled_back_vertices = undo.moved_vertices;
-      if (j == L) final_pairs = undo.remaining_pairs;
-    }
+    if (options.undo_self_intersections)
+      out.rolled_back_vertices = undo_self_intersections(V, V_level_start, model.faces(j), snake.rings()).moved_vertices;
     out.seconds = seconds_since(t_level);
     out.surface = TriMesh{V, model.faces(j)};
     result.levels.push_back(std::move(out));
@@ -321,9 +316,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   result.surface = TriMesh{V, model.faces(L)};
   result.compute_seconds = seconds_since(t_start);
   report(progress, "levels", 1.0);
-  if (final_pairs >= 0) {
-    result.self_intersections = final_pairs;
-  } else if (options.count_self_intersections) {
+  if (options.count_self_intersections) {
     report(progress, "self-intersections", 0.0);
     result.self_intersections = count_self_intersections(result.surface);
     end_stage("self_intersections");

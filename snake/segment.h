@@ -107,7 +107,7 @@ struct SegmentResult {
   int self_intersections = -1; ///< -1 when not counted
   std::string force;           ///< "profile" or "step_edge"
   std::vector<std::pair<std::string, double>> stage_seconds;
-  double compute_seconds = 0;  ///< everything after loading (with the self-intersection checks of the levels, whose last is the final count)
+  double compute_seconds = 0;  ///< everything after loading, without the final self-intersection count
 };
 
 /// Segments `image` (any spacing and direction; not modified) with the model.

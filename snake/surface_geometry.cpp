@@ -88,13 +88,16 @@ void median_on_rings(const VertexRings& rings, Eigen::VectorXd& values, int pass
   for (int p = 0; p < passes; ++p) {
     for (int v = 0; v < rings.num_vertices(); ++v) {
       window.assign(1, values[v]);
-      for (int k = rings.offsets[v]; k < rings.offsets[v + 1]; ++k) window.push_back(values[rings.neighbors[k]]);
+      for (int k = rings.offsets[v]; k < rings.offsets[v + 1]; ++k) {  // insertion sort: rings are small
+        const double x = values[rings.neighbors[k]];
+        window.push_back(x);
+        std::size_t i = window.size() - 1;
+        for (; i > 0 && window[i - 1] > x; --i) window[i] = window[i - 1];
+        window[i] = x;
+      }
       const std::size_t mid = window.size() / 2;
-      std::nth_element(window.begin(), window.begin() + static_cast<long>(mid), window.end());
-      double m = window[mid];
-      if (window.size() % 2 == 0)  // the mean of the two middle values
-        m = 0.5 * (m + *std::max_element(window.begin(), window.begin() + static_cast<long>(mid)));
-      tmp[v] = m;
+      // An even window takes the mean of its two middle values.
+      tmp[v] = window.size() % 2 ? window[mid] : 0.5 * (window[mid - 1] + window[mid]);
     }
     values.swap(tmp);
   }
