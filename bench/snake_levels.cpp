@@ -59,7 +59,8 @@ int main(int argc, char** argv) {
                                         {"min_range_voxels", &o.min_range_voxels},
                                         {"max_profile_cost", &o.max_profile_cost},
                                         {"profile_step", &o.profile_step_fraction},
-                                        {"max_range_voxels", &o.max_range_voxels}};
+                                        {"max_range_voxels", &o.max_range_voxels},
+                                        {"min_edge_voxels", &o.min_edge_voxels}};
     if (key == "smoothing") o.snake.offset_smoothing = static_cast<int>(v);
     else if (key == "median") o.snake.offset_median = static_cast<int>(v);
     else if (key == "undo") o.undo_self_intersections = v != 0;

@@ -303,7 +303,14 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     out.vertices = static_cast<int>(V.rows());
     out.synthesis_seconds = synthesis_seconds;
     const RowMatrixX3d V_level_start = V;
-    out.snake = snake.run(V, search, step, range);
+    // With profiles, a level finer than the image's voxels is only synthesized: its profiles
+    // sample the same voxels as its parent's, and on the real images its snake lost Dice.
+    // (The step-edge force fits sub-voxel steps; on synthetic volumes those levels help.)
+    const bool finer_than_image = use_profiles && edges[j] < options.min_edge_voxels * spacings[0];
+    SnakeLevelReport skipped;
+    skipped.converged = true;
+    out.snake = finer_than_image ? skipped : snake.run(V, search, step, range);
+    out.deformed = !finer_than_image;
     // The fold test inside the run is local; a surface can still pass through itself.
     if (options.undo_self_intersections)
       out.rolled_back_vertices = undo_self_intersections(V, V_level_start, model.faces(j), snake.rings()).moved_vertices;
@@ -358,6 +365,7 @@ nlohmann::json segment_report(const SegmentResult& r) {
                       {"mean_abs_offset_mm", l.snake.mean_abs_offset_mm},
                       {"rejected_steps", l.snake.rejected_steps},
                       {"rolled_back_vertices", l.rolled_back_vertices},
+                      {"deformed", l.deformed},
                       {"flipped_faces", l.snake.flipped_faces}});
   }
   j["levels"] = levels;

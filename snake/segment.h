@@ -82,6 +82,10 @@ struct SegmentOptions {
   /// After each level, move the vertices of self-intersecting faces back towards the
   /// level's start (deformable_surface.h).
   bool undo_self_intersections = true;
+  /// With the profile force, levels whose mean edge (on the model) is below this many voxels
+  /// of the image are only synthesized, not deformed (0: deform every level). On the real
+  /// images their snake lost Dice (e.g. the CT liver's finest level).
+  double min_edge_voxels = 1.0;
 };
 
 struct LevelOutcome {
@@ -92,6 +96,7 @@ struct LevelOutcome {
   int vertices = 0;
   SnakeLevelReport snake;
   int rolled_back_vertices = 0;  ///< vertices moved back to undo self-intersections
+  bool deformed = true;          ///< false: finer than the image (min_edge_voxels), only synthesized
   double seconds = 0;          ///< synthesis + snake of this level
   double synthesis_seconds = 0;
   TriMesh surface;             ///< S_j after deformation

@@ -100,6 +100,7 @@ CaseOutcome run_case(SynthShape shape, std::uint64_t target_seed, std::uint64_t 
       else if (key == "min_range_voxels") opts.min_range_voxels = v;
       else if (key == "max_profile_cost") opts.max_profile_cost = v;
       else if (key == "profile_step") opts.profile_step_fraction = v;
+      else if (key == "min_edge_voxels") opts.min_edge_voxels = v;
       else ADD_FAILURE() << "unknown MRSNAKE_E2E_OPTIONS key " << key;
     }
   }
@@ -283,6 +284,11 @@ TEST(SegmentReal, LiverOfTheAbdomenCtReachesDice09WithoutSelfIntersections) {
     ASSERT_EQ(s.exit_code, 0) << s.output;
     const nlohmann::json rep = nlohmann::json::parse(s.output);
     EXPECT_EQ(rep["self_intersections"], 0);
+    // The finest level's edges (~2.3 mm) are below the 3 mm voxels: synthesized, not deformed.
+    ASSERT_EQ(rep["levels"].size(), 5u);
+    EXPECT_FALSE(rep["levels"][4]["deformed"].get<bool>());
+    EXPECT_EQ(rep["levels"][4]["iterations"], 0);
+    EXPECT_TRUE(rep["levels"][3]["deformed"].get<bool>());
     dice[iterations == 0 ? 0 : 1] = rep["scores"]["dice"].get<double>();
     std::printf("real liver%s: Dice %.4f ASSD %.3f mm, self-intersections %d\n", cap.c_str(), dice[iterations == 0 ? 0 : 1],
                 rep["scores"]["assd_mm"].get<double>(), rep["self_intersections"].get<int>());
