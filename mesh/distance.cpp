@@ -7,6 +7,8 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
+#include <CGAL/box_intersection_d.h>
+#include <CGAL/intersections.h>
 
 #include <algorithm>
 #include <cmath>
@@ -156,13 +158,38 @@ SurfaceDistance surface_distance(const TriMesh& mesh, const TriMesh& reference, 
   return r;
 }
 
-int count_self_intersections(const TriMesh& mesh) {
+std::vector<std::pair<int, int>> crossing_face_pairs(const TriMesh& mesh) {
+  using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int>;
+  std::vector<Box> boxes;
+  std::vector<Triangle> triangles(static_cast<std::size_t>(mesh.num_faces()));
+  boxes.reserve(mesh.num_faces());
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    const int a = mesh.F(f, 0), b = mesh.F(f, 1), c = mesh.F(f, 2);
+    if (a == b || b == c || c == a) continue;
+    triangles[f] = Triangle(to_cgal(mesh.V.row(a)), to_cgal(mesh.V.row(b)), to_cgal(mesh.V.row(c)));
+    boxes.emplace_back(triangles[f].bbox(), f);
+  }
+  std::vector<std::pair<int, int>> out;
+  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const Box& x, const Box& y) {
+    const int f = x.info(), g = y.info();
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k)
+        if (mesh.F(f, i) == mesh.F(g, k)) return;  // neighbours: left to the fold tests
+    if (CGAL::do_intersect(triangles[f], triangles[g])) out.emplace_back(std::min(f, g), std::max(f, g));
+  });
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<std::pair<int, int>> self_intersecting_face_pairs(const TriMesh& mesh) {
   using SurfaceMesh = CGAL::Surface_mesh<Point>;
   using Face = SurfaceMesh::Face_index;
   SurfaceMesh sm;
   std::vector<SurfaceMesh::Vertex_index> vertices;
   vertices.reserve(mesh.num_vertices());
   for (int v = 0; v < mesh.num_vertices(); ++v) vertices.push_back(sm.add_vertex(to_cgal(mesh.V.row(v))));
+  std::vector<int> original;  // mesh.F row of each CGAL face (faces with a repeated corner are skipped)
+  original.reserve(mesh.num_faces());
   for (int f = 0; f < mesh.num_faces(); ++f) {
     const int a = mesh.F(f, 0), b = mesh.F(f, 1), c = mesh.F(f, 2);
     if (a == b || b == c || c == a) continue;  // a repeated corner: no triangle to intersect
@@ -171,11 +198,20 @@ int count_self_intersections(const TriMesh& mesh) {
       throw TopologyError("face " + std::to_string(f) +
                           " makes the mesh non-manifold or inconsistently oriented, so its self-intersections "
                           "cannot be counted; check it with 'mrsnake info'");
+    original.push_back(f);
   }
   std::vector<std::pair<Face, Face>> pairs;
   CGAL::Polygon_mesh_processing::self_intersections(sm, std::back_inserter(pairs));
-  return static_cast<int>(pairs.size());
+  std::vector<std::pair<int, int>> out;
+  out.reserve(pairs.size());
+  for (const auto& [f, g] : pairs) {
+    const int a = original[static_cast<std::size_t>(f.idx())], b = original[static_cast<std::size_t>(g.idx())];
+    out.emplace_back(std::min(a, b), std::max(a, b));
+  }
+  return out;
 }
+
+int count_self_intersections(const TriMesh& mesh) { return static_cast<int>(self_intersecting_face_pairs(mesh).size()); }
 
 void to_json(nlohmann::json& j, const SurfaceDistance& d) {
   j = nlohmann::json{

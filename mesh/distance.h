@@ -3,6 +3,8 @@
 /// Distances between surfaces and closest-point queries (CGAL AABB tree behind a small
 /// adapter: no CGAL type crosses this header).
 #include <memory>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -64,6 +66,17 @@ SurfaceDistance surface_distance(const TriMesh& mesh, const TriMesh& reference, 
 /// \throw TopologyError if a face makes the mesh non-manifold or inconsistently oriented
 ///        (CGAL's halfedge mesh cannot hold it).
 int count_self_intersections(const TriMesh& mesh);
+
+/// The pairs of faces (indices into mesh.F, first < second) that share no vertex and
+/// intersect: the surface passing through itself. Faster than self_intersecting_face_pairs
+/// (boxes, then an exact triangle test on the non-adjacent overlaps only), but blind to
+/// faces that share a vertex or an edge and overlap (a fold), which it leaves to the caller.
+std::vector<std::pair<int, int>> crossing_face_pairs(const TriMesh& mesh);
+
+/// The pairs of faces (indices into mesh.F, first < second) that intersect, as
+/// count_self_intersections counts them.
+/// \throw TopologyError as count_self_intersections does.
+std::vector<std::pair<int, int>> self_intersecting_face_pairs(const TriMesh& mesh);
 
 void to_json(nlohmann::json& j, const SurfaceDistance& d);
 

@@ -11,12 +11,18 @@
 ///                 similarity invariant; this is the local-frame detail prior)
 ///  - thin plate   −β·(mean(r_ring) − r_v), r_v = (h_v − ĥ_v·ℓ_v)·n_v (squared umbrella of
 ///                 the prior residual)
-///  - tangential   w_t·(U_v − h_v·n_v)             (keeps the sampling uniform)
+///  - tangential   w_t·(U_v − h_v·n_v − T_v)       (keeps the model's sampling: T_v is the
+///                 model's tangential umbrella, scaled by ℓ_v/ℓ̂_v and turned into the current
+///                 tangent plane by the rotation that best maps the model's ring directions
+///                 onto the current ones; zero at the model's shape in any pose, so that the
+///                 wavelet details land where the model put them. A plain uniform pull here
+///                 deformed coarse meshes: Dice 0.97 → 0.84 on the CT liver without any image force)
 ///  - external     w_e·o_v·n_v, o_v the matched offset along the normal, averaged over the
 ///                 1-ring to resist noise
 /// Each step x ← x + τ·F is capped to max_step_fraction·ℓ_v and to |o_v| + that cap along
 /// the normal. Faces that would turn against their normal at the level's start, or by more
 /// than 60° in one step, reject the step of their vertices (halved, then dropped). The run stops when the matched offsets and the energy stop changing.
+#include <complex>
 #include <functional>
 #include <limits>
 #include <vector>
@@ -31,10 +37,11 @@ struct SnakeOptions {
   double membrane_weight = 0.0;     ///< α
   double thin_plate_weight = 0.05;  ///< β (τ·β must stay below ~0.4)
   double prior_weight = 0.35;       ///< w_p
-  double tangential_weight = 0.35;  ///< w_t (τ·(α + w_p + w_t) must stay below ~1.2)
-  double external_weight = 0.5;     ///< w_e: fraction of the matched offset taken per step
+  double tangential_weight = 0.35;  ///< w_t, towards the model's tangential umbrella (τ·(α + w_p + w_t) must stay below ~1.2)
+  double external_weight = 0.3;     ///< w_e: fraction of the matched offset taken per step
   double time_step = 1.0;           ///< τ
   double max_step_fraction = 0.3;   ///< cap on a step, in local edge lengths
+  int offset_median = 1;            ///< ring-median passes over the matched offsets (before the averaging)
   int offset_smoothing = 1;         ///< ring-averaging passes over the matched offsets
   int max_iterations = 40;
   int min_iterations = 4;
@@ -69,6 +76,34 @@ struct SnakeLevelReport {
 /// \pre model_V has rings.num_vertices() rows.
 Eigen::VectorXd relative_normal_umbrella(const VertexRings& rings, const RowMatrixX3i& F, const RowMatrixX3d& model_V);
 
+/// The tangential part of the local-frame prior: per vertex, the model's tangential
+/// umbrella in its tangent basis (e1 towards the first ring neighbour, e2 = n × e1) over ℓ̂_v,
+/// as a complex number, and the unit directions of its ring edges in that basis (CSR like
+/// the rings).
+struct TangentialPrior {
+  std::vector<std::complex<double>> umbrella;
+  std::vector<std::complex<double>> ring_directions;
+};
+
+/// \pre model_V has rings.num_vertices() rows.
+TangentialPrior tangential_prior(const VertexRings& rings, const RowMatrixX3i& F, const RowMatrixX3d& model_V);
+
+/// What undo_self_intersections did.
+struct UndoOutcome {
+  int moved_vertices = 0;     ///< vertices moved back towards the safe positions
+  int remaining_pairs = 0;    ///< crossing face pairs left (mesh/distance.h)
+};
+
+/// Undoes self-intersections: the vertices of crossing faces (faces that share no vertex and
+/// intersect, mesh/distance.h's crossing_face_pairs; folds of neighbours are the snake's
+/// flip test's business), and their rings, move back
+/// towards `safe` (their displacement halved per round, then dropped), until no pair of
+/// faces intersects or `max_rounds` rounds have run. Faces that intersect in `safe` itself
+/// cannot be resolved this way and stay (counted in remaining_pairs).
+/// \pre V and safe have the same rows; F references them; rings built from F.
+UndoOutcome undo_self_intersections(RowMatrixX3d& V, const RowMatrixX3d& safe, const RowMatrixX3i& F,
+                                    const VertexRings& rings, int max_rounds = 8);
+
 /// The snake of one level.
 class DeformableSurface {
  public:
@@ -92,6 +127,7 @@ class DeformableSurface {
   RowMatrixX3i F_;
   VertexRings rings_;
   Eigen::VectorXd prior_;
+  TangentialPrior tangential_;
   SnakeOptions options_;
 };
 

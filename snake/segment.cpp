@@ -190,7 +190,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     so.range_mm = range_mm;
     if (use_profiles) {
       const LevelAppearance* la = &model.appearance->levels[j];
-      so.step_mm = la->spacing_mm;
+      so.step_mm = options.profile_step_fraction * la->spacing_mm;
       so.max_cost = options.max_profile_cost;
       return {[sampler, la, so](const RowMatrixX3d& V, const RowMatrixX3d& N) {
                 return search_profiles(*sampler, V, N, la->profiles, la->spacing_mm, so);
@@ -205,8 +205,10 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
             },
             so.step_mm};
   };
-  const auto range_for = [&](int j, double fraction) {
-    return std::max(options.min_range_voxels * spacings[pyr[j]], fraction * edges[j]);
+  const auto range_for = [&](int j, double fraction, double min_voxels) {
+    double r = std::max(min_voxels * spacings[pyr[j]], fraction * edges[j]);
+    if (options.max_range_voxels > 0) r = std::min(r, options.max_range_voxels * spacings[pyr[j]]);
+    return r;
   };
 
   // Initialization of the coarse mesh.
@@ -303,7 +305,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     // Fit the whole mesh of a level with enough vertices to carry the shape; synthesis
     // follows a similarity, so the pose found there applies to S_0 as well.
     const int jf = std::min(L, options.fit_level);
-    const auto [search, step] = search_for(jf, range_for(jf, options.coarse_range_edge_fraction), stats);
+    const auto [search, step] = search_for(jf, range_for(jf, options.coarse_range_edge_fraction, options.fit_min_range_voxels), stats);
     (void)step;
     double best_cost = std::numeric_limits<double>::infinity();
     for (const Similarity& start : starts) {
@@ -338,7 +340,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
       V = model.synthesize(j - 1, V);
       synthesis_seconds = seconds_since(t_syn);
     }
-    const double range = range_for(j, options.range_edge_fraction);
+    const double range = range_for(j, options.range_edge_fraction, options.min_range_voxels);
     const auto [search, step] = search_for(j, range, stats);
     const DeformableSurface snake(model.faces(j), model.levels[j], options.snake);
     LevelOutcome out;
@@ -348,7 +350,18 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     out.range_mm = range;
     out.vertices = static_cast<int>(V.rows());
     out.synthesis_seconds = synthesis_seconds;
-    out.snake = snake.run(V, search, step, range);
+    const RowMatrixX3d V_level_start = V;
+    // With profiles, a level finer than the image's voxels is only synthesized: its profiles
+    // sample the same voxels as its parent's, and on the real images its snake lost Dice.
+    // (The step-edge force fits sub-voxel steps; on synthetic volumes those levels help.)
+    const bool finer_than_image = use_profiles && edges[j] < options.min_edge_voxels * spacings[0];
+    SnakeLevelReport skipped;
+    skipped.converged = true;
+    out.snake = finer_than_image ? skipped : snake.run(V, search, step, range);
+    out.deformed = !finer_than_image;
+    // The fold test inside the run is local; a surface can still pass through itself.
+    if (options.undo_self_intersections)
+      out.rolled_back_vertices = undo_self_intersections(V, V_level_start, model.faces(j), snake.rings()).moved_vertices;
     out.seconds = seconds_since(t_level);
     out.surface = TriMesh{V, model.faces(j)};
     result.levels.push_back(std::move(out));
@@ -439,6 +452,8 @@ nlohmann::json segment_report(const SegmentResult& r) {
                       {"internal_energy", l.snake.internal_energy},
                       {"mean_abs_offset_mm", l.snake.mean_abs_offset_mm},
                       {"rejected_steps", l.snake.rejected_steps},
+                      {"rolled_back_vertices", l.rolled_back_vertices},
+                      {"deformed", l.deformed},
                       {"flipped_faces", l.snake.flipped_faces}});
   }
   j["levels"] = levels;

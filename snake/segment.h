@@ -76,13 +76,24 @@ struct SegmentOptions {
   /// coarsest level uses coarse_range_edge_fraction for the initial fit.
   double range_edge_fraction = 0.5;
   double coarse_range_edge_fraction = 0.75;
-  double min_range_voxels = 4.0;
+  double min_range_voxels = 1.0;      ///< levels: the search range is at least this many voxels
+  double fit_min_range_voxels = 4.0;  ///< the initial fit's search range is at least this many voxels
   double step_voxels = 0.5;       ///< search step, in voxels of the pyramid level
+  double profile_step_fraction = 0.5;  ///< profile search step, as a fraction of the profile spacing
+  /// Fine levels: the search range is at most this many voxels of the pyramid level (0: no cap).
+  double max_range_voxels = 0;
   double window_voxels = 2.0;     ///< step_edge half window, in voxels of the pyramid level
   double edge_per_voxel = 2.0;    ///< pyramid level choice (appearance.h)
   double max_edge_cost = 0.35;    ///< step-edge matches worse than this are ignored (forces.h)
-  double max_profile_cost = 0.9;  ///< profile matches with a correlation below 0.1 are ignored
+  double max_profile_cost = 0.4;  ///< profile matches with a correlation below 0.6 are ignored
   bool count_self_intersections = true;
+  /// After each level, move the vertices of self-intersecting faces back towards the
+  /// level's start (deformable_surface.h).
+  bool undo_self_intersections = true;
+  /// With the profile force, levels whose mean edge (on the model) is below this many voxels
+  /// of the image are only synthesized, not deformed (0: deform every level). On the real
+  /// images their snake lost Dice (e.g. the CT liver's finest level).
+  double min_edge_voxels = 1.0;
 };
 
 struct LevelOutcome {
@@ -92,6 +103,8 @@ struct LevelOutcome {
   double range_mm = 0;
   int vertices = 0;
   SnakeLevelReport snake;
+  int rolled_back_vertices = 0;  ///< vertices moved back to undo self-intersections
+  bool deformed = true;          ///< false: finer than the image (min_edge_voxels), only synthesized
   double seconds = 0;          ///< synthesis + snake of this level
   double synthesis_seconds = 0;
   TriMesh surface;             ///< S_j after deformation
@@ -109,7 +122,7 @@ struct SegmentResult {
   int self_intersections = -1; ///< -1 when not counted
   std::string force;           ///< "profile" or "step_edge"
   std::vector<std::pair<std::string, double>> stage_seconds;
-  double compute_seconds = 0;  ///< everything after loading, without the self-intersection count
+  double compute_seconds = 0;  ///< everything after loading, without the final self-intersection count
 };
 
 /// Segments `image` (any spacing and direction; not modified) with the model.

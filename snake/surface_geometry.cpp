@@ -82,4 +82,25 @@ void smooth_on_rings(const VertexRings& rings, Eigen::VectorXd& values, int pass
   }
 }
 
+void median_on_rings(const VertexRings& rings, Eigen::VectorXd& values, int passes) {
+  Eigen::VectorXd tmp(values.size());
+  std::vector<double> window;
+  for (int p = 0; p < passes; ++p) {
+    for (int v = 0; v < rings.num_vertices(); ++v) {
+      window.assign(1, values[v]);
+      for (int k = rings.offsets[v]; k < rings.offsets[v + 1]; ++k) {  // insertion sort: rings are small
+        const double x = values[rings.neighbors[k]];
+        window.push_back(x);
+        std::size_t i = window.size() - 1;
+        for (; i > 0 && window[i - 1] > x; --i) window[i] = window[i - 1];
+        window[i] = x;
+      }
+      const std::size_t mid = window.size() / 2;
+      // An even window takes the mean of its two middle values.
+      tmp[v] = window.size() % 2 ? window[mid] : 0.5 * (window[mid - 1] + window[mid]);
+    }
+    values.swap(tmp);
+  }
+}
+
 }  // namespace mrsnake

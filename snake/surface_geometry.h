@@ -37,4 +37,8 @@ void ring_edge_lengths(const VertexRings& rings, const RowMatrixX3d& V, Eigen::V
 /// Replaces each value by the mean over the vertex and its ring, `passes` times.
 void smooth_on_rings(const VertexRings& rings, Eigen::VectorXd& values, int passes);
 
+/// Replaces each value by the median over the vertex and its ring, `passes` times (an
+/// outlier among its neighbours, e.g. a false profile match, does not move a vertex).
+void median_on_rings(const VertexRings& rings, Eigen::VectorXd& values, int passes);
+
 }  // namespace mrsnake

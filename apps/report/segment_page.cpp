@@ -158,6 +158,7 @@ std::string segment_report_html(const SegmentPageInput& in) {
         {"level", "level"}, {"vertices", "vertices"}, {"pyramid_level", "pyramid level"}, {"voxel_mm", "voxel (mm)"},
         {"search_range_mm", "search range (mm)"}, {"iterations", "iterations"}, {"converged", "converged"},
         {"energy", "energy"}, {"mean_abs_offset_mm", "mean |offset| (mm)"}, {"rejected_steps", "rejected steps"},
+        {"rolled_back_vertices", "rolled back"}, {"deformed", "deformed"},
         {"flipped_faces", "flipped faces"}, {"synthesis_seconds", "synthesis (s)"}, {"seconds", "seconds"}};
     std::vector<std::string> header;
     for (const auto& c : columns) header.push_back(c.second);

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <vector>
@@ -201,4 +202,32 @@ TEST(SelfIntersections, NoneOnASphereSomeOnTwoInterpenetratingSpheres) {
   const int pairs = count_self_intersections(merged(sphere, overlapping));
   // The circle of intersection (radius √3/2) crosses many faces of both spheres.
   EXPECT_GT(pairs, 20);
+  // The pairs as a list, and the crossing pairs (no shared vertex): here the same pairs.
+  const TriMesh both = merged(sphere, overlapping);
+  const auto listed = self_intersecting_face_pairs(both);
+  EXPECT_EQ(static_cast<int>(listed.size()), pairs);
+  for (const auto& [f, g] : listed) {
+    EXPECT_LT(f, g);
+    EXPECT_TRUE((f < sphere.num_faces()) != (g < sphere.num_faces())) << f << " " << g;  // one face of each
+  }
+  auto sorted = listed;
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_EQ(crossing_face_pairs(both), sorted);
+  EXPECT_TRUE(crossing_face_pairs(merged(sphere, apart)).empty());
+}
+
+TEST(SelfIntersections, CrossingPairsIgnoreAFoldOfNeighboursThatTheFullCountSees) {
+  // One vertex of a sphere pushed just through the far side of its own ring: its faces
+  // cross faces that share no vertex with them. A fan of two triangles folded onto each
+  // other (sharing an edge) is seen by the full count only.
+  TriMesh sphere = icosphere(2, 1.0);
+  sphere.V.row(0) *= -1.5;
+  EXPECT_GT(crossing_face_pairs(sphere).size(), 0u);
+  TriMesh folded;
+  folded.V.resize(4, 3);
+  folded.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0.2, 0.2, 0;  // the 4th corner lies inside the first face
+  folded.F.resize(2, 3);
+  folded.F << 0, 1, 2, 1, 0, 3;
+  EXPECT_TRUE(crossing_face_pairs(folded).empty());
+  EXPECT_EQ(count_self_intersections(folded), 1);
 }

@@ -7,6 +7,7 @@
 #include <limits>
 #include <random>
 
+#include "mesh/distance.h"
 #include "mesh/errors.h"
 #include "mesh/marching_cubes.h"
 #include "mesh/primitives.h"
@@ -198,7 +199,7 @@ TEST(Internal, PriorTermIsZeroAtTheModelsShapeInAnyPose) {
     m.V.row(v) = x.transpose();
   }
   SnakeOptions o;
-  o.tangential_weight = 0;  // the tangential term regularizes sampling, not shape
+  o.tangential_weight = 0.5;  // relative to the model's tangential umbrella: zero there too
   o.membrane_weight = 0;
   o.prior_weight = 0.5;
   o.thin_plate_weight = 0.2;
@@ -222,6 +223,97 @@ TEST(Internal, PriorTermIsZeroAtTheModelsShapeInAnyPose) {
   vertex_normals(m.V, m.F, N);
   bumped.row(100) += 2.0 * N.row(100);
   EXPECT_LT(snake.internal_forces(bumped).row(100).dot(N.row(100)), -0.1);
+}
+
+TEST(Internal, TangentialTermKeepsTheModelsSamplingNotAUniformOne) {
+  // A non-uniformly sampled sphere: vertices crowd towards +z. The tangential term measured
+  // against the model is zero there in any pose, and pulls a vertex slid along the surface
+  // back; a plain uniform tangential pull (the model's own umbrella not subtracted) is not
+  // zero on it, which moved coarse real meshes away from the model before any image force.
+  TriMesh m = icosphere(3, 10.0);
+  for (int v = 0; v < m.num_vertices(); ++v) {
+    Eigen::Vector3d x = m.V.row(v);
+    x.z() = 10.0 * std::sin(0.5 * M_PI * (0.6 * x.z() / 10.0 + 0.4 * std::pow(x.z() / 10.0, 3)));
+    m.V.row(v) = (10.0 * x.normalized()).transpose();
+  }
+  SnakeOptions o;
+  o.membrane_weight = 0;
+  o.prior_weight = 0;
+  o.thin_plate_weight = 0;
+  o.tangential_weight = 1.0;
+  const DeformableSurface snake(m.F, m.V, o);
+  EXPECT_LT(snake.internal_forces(m.V).rowwise().norm().maxCoeff(), 1e-10);
+  Similarity s;
+  s.rotation = rotation(120, {-1, 0.5, 2});
+  s.scale = 0.4;
+  s.translation = {-7, 3, 1};
+  EXPECT_LT(snake.internal_forces(s.apply(m.V)).rowwise().norm().maxCoeff(), 1e-9);
+  // A vertex slid tangentially by 0.3 mm is pulled back along the slide.
+  RowMatrixX3d N;
+  vertex_normals(m.V, m.F, N);
+  const int v = 200;
+  const Eigen::Vector3d slide = N.row(v).transpose().unitOrthogonal() * 0.3;
+  RowMatrixX3d slid = m.V;
+  slid.row(v) += slide.transpose();
+  EXPECT_LT(snake.internal_forces(slid).row(v).dot(slide), -0.1 * slide.squaredNorm());
+  // What the old uniform pull gives on the model itself: the umbrella's tangential part.
+  RowMatrixX3d U;
+  umbrella(snake.rings(), m.V, U);
+  double uniform_max = 0;
+  for (int k = 0; k < m.num_vertices(); ++k)
+    uniform_max = std::max(uniform_max, (U.row(k) - U.row(k).dot(N.row(k)) * N.row(k)).norm());
+  EXPECT_GT(uniform_max, 0.05);
+}
+
+TEST(Internal, RingMedianRemovesAnIsolatedOutlierThatTheMeanSpreads) {
+  const TriMesh m = icosphere(2, 10.0);
+  const VertexRings rings = build_vertex_rings(m.F, m.num_vertices());
+  Eigen::VectorXd values = Eigen::VectorXd::Constant(m.num_vertices(), 1.0);
+  values[17] = 12.0;  // a false match
+  Eigen::VectorXd mean = values, median = values;
+  smooth_on_rings(rings, mean, 1);
+  median_on_rings(rings, median, 1);
+  EXPECT_NEAR(median.maxCoeff(), 1.0, 1e-15);
+  EXPECT_NEAR(median.minCoeff(), 1.0, 1e-15);
+  EXPECT_GT(mean.maxCoeff(), 2.0);  // the mean spreads it over the ring
+  // An even window takes the mean of its two middle values; a monotone field stays monotone.
+  Eigen::VectorXd ramp(m.num_vertices());
+  for (int v = 0; v < m.num_vertices(); ++v) ramp[v] = m.V(v, 2);
+  Eigen::VectorXd filtered = ramp;
+  median_on_rings(rings, filtered, 1);
+  EXPECT_LE(filtered.maxCoeff(), ramp.maxCoeff() + 1e-12);
+  EXPECT_GE(filtered.minCoeff(), ramp.minCoeff() - 1e-12);
+}
+
+TEST(Snake, UndoSelfIntersectionsRestoresAnIntersectionFreeSurface) {
+  const TriMesh m = icosphere(3, 10.0);
+  const VertexRings rings = build_vertex_rings(m.F, m.num_vertices());
+  // Push one vertex through the sphere and out of the far side: its faces cross others.
+  RowMatrixX3d V = m.V;
+  const int v = 5;
+  V.row(v) = -1.3 * m.V.row(v);
+  // A harmless displacement elsewhere, which must be kept.
+  const int far = 100;
+  ASSERT_GT((m.V.row(far) - m.V.row(v)).norm(), 8.0);
+  V.row(far) *= 1.02;
+  ASSERT_GT(count_self_intersections(TriMesh{V, m.F}), 0);
+  const UndoOutcome undo = undo_self_intersections(V, m.V, m.F, rings);
+  EXPECT_EQ(count_self_intersections(TriMesh{V, m.F}), 0);
+  EXPECT_EQ(undo.remaining_pairs, 0);
+  EXPECT_GT(undo.moved_vertices, 0);
+  EXPECT_LT(undo.moved_vertices, m.num_vertices() / 4);
+  EXPECT_EQ(V.row(far), (1.02 * m.V.row(far)).eval());
+  // Nothing to undo on a clean surface.
+  RowMatrixX3d clean = 1.1 * m.V;
+  EXPECT_EQ(undo_self_intersections(clean, m.V, m.F, rings).moved_vertices, 0);
+  EXPECT_EQ(clean, (1.1 * m.V).eval());
+  // An intersection already in the safe positions stays, and is counted.
+  RowMatrixX3d stuck = V;
+  stuck.row(v) = -1.3 * m.V.row(v);
+  const RowMatrixX3d unsafe = stuck;
+  const UndoOutcome left = undo_self_intersections(stuck, unsafe, m.F, rings);
+  EXPECT_EQ(left.remaining_pairs, count_self_intersections(TriMesh{unsafe, m.F}));
+  EXPECT_GT(left.remaining_pairs, 0);
 }
 
 TEST(Model, MidpointFrameSynthesisFollowsASimilarity) {
