@@ -3,6 +3,8 @@
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/convex_hull_3.h>
 
+#include <algorithm>
+#include <array>
 #include <map>
 #include <tuple>
 #include <vector>
@@ -25,17 +27,26 @@ RowMatrixX3i convex_hull_faces(const RowMatrixX3d& points) {
   SurfaceMesh hull;
   CGAL::convex_hull_3(pts.begin(), pts.end(), hull);
   if (hull.number_of_faces() < 4) throw AlgorithmError("the base mesh is degenerate (its points are coplanar)");
-  RowMatrixX3i F(static_cast<int>(hull.number_of_faces()), 3);
-  int row = 0;
+  std::vector<std::array<int, 3>> faces;
+  faces.reserve(hull.number_of_faces());
   for (const auto f : hull.faces()) {
+    std::array<int, 3> face{};
     int k = 0;
     for (const auto v : CGAL::vertices_around_face(hull.halfedge(f), hull)) {
       if (k == 3) throw AlgorithmError("the convex hull of the base points has a non-triangular face");
       const Point_3& p = hull.point(v);
-      F(row, k++) = index.at(std::make_tuple(p.x(), p.y(), p.z()));
+      face[k++] = index.at(std::make_tuple(p.x(), p.y(), p.z()));
     }
-    ++row;
+    // Smallest index first (orientation kept).
+    std::rotate(face.begin(), std::min_element(face.begin(), face.end()), face.end());
+    faces.push_back(face);
   }
+  // CGAL's face order follows its internal (address-dependent) bookkeeping, so it can change
+  // from call to call in one process: sorted, the same points always give the same faces.
+  std::sort(faces.begin(), faces.end());
+  RowMatrixX3i F(static_cast<int>(faces.size()), 3);
+  for (std::size_t i = 0; i < faces.size(); ++i)
+    for (int k = 0; k < 3; ++k) F(static_cast<int>(i), k) = faces[i][k];
   return F;
 }
 
