@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mesh/errors.h"
+#include "mesh/vertex_stars.h"
 
 namespace mrsnake {
 namespace {
@@ -115,15 +116,9 @@ TopologyReport topology_report(const TriMesh& mesh) {
   // Non-manifold vertices: the link (opposite edges of the incident faces) must be connected.
   // Incident faces in one flat array (offsets per vertex); a star's link vertices are
   // numbered by their rank in its sorted list.
-  std::vector<int> offset(n + 1, 0), incident(3 * static_cast<std::size_t>(m));
-  for (int f = 0; f < m; ++f)
-    for (int k = 0; k < 3; ++k) ++offset[mesh.F(f, k) + 1];
-  for (int v = 0; v < n; ++v) offset[v + 1] += offset[v];
-  {
-    std::vector<int> fill(offset.begin(), offset.end() - 1);
-    for (int f = 0; f < m; ++f)
-      for (int k = 0; k < 3; ++k) incident[fill[mesh.F(f, k)]++] = f;
-  }
+  const VertexStars stars(mesh.F, n);
+  const std::vector<int>& offset = stars.offset;
+  const std::vector<int>& incident = stars.faces;
   std::vector<int> link, parent;
   for (int v = 0; v < n; ++v) {
     if (offset[v + 1] - offset[v] < 2) continue;

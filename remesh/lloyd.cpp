@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "mesh/parallel.h"
+#include "remesh/surface_moves.h"
 
 namespace mrsnake {
 namespace {
@@ -13,19 +14,6 @@ namespace {
 Eigen::Vector3d quad_centroid(const Eigen::Vector3d& v, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return (11.0 / 18.0) * v + (7.0 / 36.0) * (a + b);
 }
-
-struct VertexFaces {
-  std::vector<int> offset, faces;
-  VertexFaces(const RowMatrixX3i& F, int n) : offset(n + 1, 0) {
-    for (int f = 0; f < F.rows(); ++f)
-      for (int k = 0; k < 3; ++k) ++offset[F(f, k) + 1];
-    for (int v = 0; v < n; ++v) offset[v + 1] += offset[v];
-    faces.resize(offset[n]);
-    std::vector<int> fill(offset.begin(), offset.end() - 1);
-    for (int f = 0; f < F.rows(); ++f)
-      for (int k = 0; k < 3; ++k) faces[fill[F(f, k)]++] = f;
-  }
-};
 
 }  // namespace
 
@@ -68,7 +56,7 @@ LloydStats constrained_lloyd(DomainKind kind, const RowMatrixX3i& F, const Densi
   const int n = static_cast<int>(U.rows());
   const int m = static_cast<int>(F.rows());
   const std::vector<bool> boundary = kind == DomainKind::disk ? boundary_vertices(F, n) : std::vector<bool>(n, false);
-  const VertexFaces star(F, n);
+  const VertexStars star(F, n);
   std::vector<int> face_hint(m);
   for (int f = 0; f < m; ++f) face_hint[f] = vertex_hints[F(f, 0)];
   const int r = std::min(48, static_cast<int>(std::floor(std::sqrt(static_cast<double>(options.sample_budget) / std::max(1, m)))));

@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <utility>
 
 #include <Eigen/Dense>
 
 #include "mesh/quality.h"
+#include "remesh/surface_moves.h"
 
 namespace mrsnake {
 namespace {
@@ -43,16 +45,7 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
   const int n = static_cast<int>(U.rows());
   const int m = static_cast<int>(F.rows());
   const std::vector<bool> boundary = kind == DomainKind::disk ? boundary_vertices(F, n) : std::vector<bool>(n, false);
-  std::vector<int> offset(n + 1, 0), star;
-  for (int f = 0; f < m; ++f)
-    for (int k = 0; k < 3; ++k) ++offset[F(f, k) + 1];
-  for (int v = 0; v < n; ++v) offset[v + 1] += offset[v];
-  star.resize(offset[n]);
-  {
-    std::vector<int> fill(offset.begin(), offset.end() - 1);
-    for (int f = 0; f < m; ++f)
-      for (int k = 0; k < 3; ++k) star[fill[F(f, k)]++] = f;
-  }
+  const VertexStars stars(F, n);
   const auto& PF = param.faces();
   const auto& PD = param.positions();
   auto quality = [&](int f, int v, const Eigen::Vector3d& x) {
@@ -64,18 +57,8 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
   // Smallest Q of v's triangles with v at x.
   auto star_quality = [&](int v, const Eigen::Vector3d& x) {
     double q = std::numeric_limits<double>::infinity();
-    for (int i = offset[v]; i < offset[v + 1]; ++i) q = std::min(q, quality(star[i], v, x));
+    for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) q = std::min(q, quality(stars.faces[i], v, x));
     return q;
-  };
-  auto unflipped_in_domain = [&](int v, const Eigen::Vector3d& u) {
-    for (int i = offset[v]; i < offset[v + 1]; ++i) {
-      const int f = star[i];
-      Eigen::Vector3d P[3] = {U.row(F(f, 0)), U.row(F(f, 1)), U.row(F(f, 2))};
-      for (int k = 0; k < 3; ++k)
-        if (F(f, k) == v) P[k] = u;
-      if (!(domain_orientation(P[0], P[1], P[2]) > 0)) return false;
-    }
-    return true;
   };
   auto lift = [&](const Eigen::Vector3d& u, int& hint) {
     const DomainMesh::Location loc = param.locate(u, hint);
@@ -91,8 +74,8 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
   auto surface_error = [&](int v, const Eigen::Vector3d& u, const Eigen::Vector3d& x, const Eigen::Vector3d& old) {
     double error = 0, to_old = std::numeric_limits<double>::infinity();
     int hint = hints[v];
-    for (int i = offset[v]; i < offset[v + 1]; ++i) {
-      const int f = star[i];
+    for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
+      const int f = stars.faces[i];
       int k = 0;
       while (F(f, k) != v) ++k;
       const int a = F(f, (k + 1) % 3), b = F(f, (k + 2) % 3);
@@ -133,45 +116,32 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
         const Eigen::Vector3d x = X.row(v);
         const double current = star_quality(v, x);
         if (!(current < options.threshold)) continue;
-        Eigen::Vector3d normal = Eigen::Vector3d::Zero(), centroid = Eigen::Vector3d::Zero(), mean_apex = Eigen::Vector3d::Zero();
+        const std::optional<Eigen::Vector3d> normal = vertex_normal(X, F, stars, v);
+        if (!normal) continue;
+        Eigen::Vector3d centroid = Eigen::Vector3d::Zero(), mean_apex = Eigen::Vector3d::Zero();
         Eigen::Vector3d worst_apex = x;
         double worst = std::numeric_limits<double>::infinity();
-        for (int i = offset[v]; i < offset[v + 1]; ++i) {
-          const int f = star[i];
-          normal += (X.row(F(f, 1)) - X.row(F(f, 0))).cross(X.row(F(f, 2)) - X.row(F(f, 0))).transpose();
-        }
-        if (!(normal.norm() > 0)) continue;
-        normal.normalize();
         int count = 0;
-        for (int i = offset[v]; i < offset[v + 1]; ++i) {
-          const int f = star[i];
+        for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
+          const int f = stars.faces[i];
           int k = 0;
           while (F(f, k) != v) ++k;
           const Eigen::Vector3d a = X.row(F(f, (k + 1) % 3)), b = X.row(F(f, (k + 2) % 3));
-          const Eigen::Vector3d side = normal.cross(b - a);  // v lies left of a -> b, seen from outside
-          if (!(side.norm() > 0)) continue;
-          const Eigen::Vector3d apex = 0.5 * (a + b) + (std::sqrt(3.0) / 2.0) * (b - a).norm() * side.normalized();
-          mean_apex += apex;
+          const std::optional<Eigen::Vector3d> apex = equilateral_apex(a, b, *normal);
+          if (!apex) continue;
+          mean_apex += *apex;
           centroid += 0.5 * (a + b);  // each neighbour twice around an interior vertex
           ++count;
           if (const double qf = quality(f, -1, Eigen::Vector3d::Zero()); qf < worst) {
             worst = qf;
-            worst_apex = apex;
+            worst_apex = *apex;
           }
         }
         if (count == 0) continue;
         const Eigen::Vector3d targets[3] = {worst_apex, mean_apex / count, centroid / count};
         // The affine map of the input triangle under v pulls a 3D move back to D.
-        const int pf = hints[v];
-        const Eigen::Vector3d x0 = surface_V.row(PF(pf, 0)), d0 = PD.row(PF(pf, 0));
-        Eigen::Matrix<double, 3, 2> XE, DE;
-        XE.col(0) = surface_V.row(PF(pf, 1)).transpose() - x0;
-        XE.col(1) = surface_V.row(PF(pf, 2)).transpose() - x0;
-        DE.col(0) = PD.row(PF(pf, 1)).transpose() - d0;
-        DE.col(1) = PD.row(PF(pf, 2)).transpose() - d0;
-        const Eigen::Matrix2d gram = XE.transpose() * XE;
-        if (!(std::abs(gram.determinant()) > 0)) continue;
-        const Eigen::LDLT<Eigen::Matrix2d> solver(gram);
+        const std::optional<TrianglePullback> pullback = TrianglePullback::of(surface_V, PD, PF, hints[v]);
+        if (!pullback) continue;
         const Eigen::Vector3d u = U.row(v);
         const double allowed_error =
             options.guard_surface_error ? std::max(surface_error(v, u, x, x), options.error_tolerance * mean_edge) : 0.0;
@@ -180,11 +150,11 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
         int best_hint = hints[v];
         for (const Eigen::Vector3d& target : targets) {
           Eigen::Vector3d move = target - x;
-          move -= move.dot(normal) * normal;
-          const Eigen::Vector3d domain_move = DE * solver.solve(XE.transpose() * move);
+          move -= move.dot(*normal) * *normal;
+          const Eigen::Vector3d domain_move = pullback->to_domain(move);
           for (double t : {1.0, 0.5, 0.25}) {
             const Eigen::Vector3d candidate = project_to_domain(kind, u + t * domain_move, boundary[v]);
-            if (!unflipped_in_domain(v, candidate)) continue;
+            if (!star_unflipped_in_domain(U, F, stars, v, candidate)) continue;
             int hint = hints[v];
             const Eigen::Vector3d lifted = lift(candidate, hint);
             const double q = star_quality(v, lifted);
