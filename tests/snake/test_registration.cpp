@@ -82,15 +82,8 @@ Eigen::Vector3d apply_pose(const SimilarityParams& p, const Eigen::Vector3d& x) 
   return p.centre + p.translation + p.scale * (p.rotation * (x - p.centre));
 }
 
-std::vector<std::uint8_t> read_all(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void write_all(const fs::path& p, const std::vector<std::uint8_t>& b) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
-}
+using test::read_all;
+using test::write_all;
 
 }  // namespace
 
