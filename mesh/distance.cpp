@@ -167,6 +167,9 @@ std::vector<std::pair<int, int>> crossing_face_pairs(const TriMesh& mesh) {
     const int a = mesh.F(f, 0), b = mesh.F(f, 1), c = mesh.F(f, 2);
     if (a == b || b == c || c == a) continue;
     triangles[f] = Triangle(to_cgal(mesh.V.row(a)), to_cgal(mesh.V.row(b)), to_cgal(mesh.V.row(c)));
+    // CGAL's triangle-triangle test requires non-degenerate triangles; a collapsed face has
+    // no area to cross with, and the fold tests of the snake see it.
+    if (triangles[f].is_degenerate()) continue;
     boxes.emplace_back(triangles[f].bbox(), f);
   }
   std::vector<std::pair<int, int>> out;

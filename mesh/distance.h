@@ -57,7 +57,7 @@ SurfaceDistance surface_distance(const TriMesh& mesh, const TriMesh& reference, 
 /// The same, with a locator already built on `reference`: several meshes measured against
 /// one reference build its tree once.
 /// \pre reference_locator was built on `reference`; both meshes have at least one face.
-/// 	hrow InputError if either mesh has no face.
+/// \throw InputError if either mesh has no face.
 SurfaceDistance surface_distance(const TriMesh& mesh, const TriMesh& reference, const SurfaceLocator& reference_locator,
                                  const DistanceOptions& options = {});
 
@@ -70,7 +70,9 @@ int count_self_intersections(const TriMesh& mesh);
 /// The pairs of faces (indices into mesh.F, first < second) that share no vertex and
 /// intersect: the surface passing through itself. Faster than self_intersecting_face_pairs
 /// (boxes, then an exact triangle test on the non-adjacent overlaps only), but blind to
-/// faces that share a vertex or an edge and overlap (a fold), which it leaves to the caller.
+/// faces that share a vertex or an edge and overlap (a fold), which it leaves to the caller,
+/// and to degenerate (zero-area) faces, which it skips.
+/// \pre every index in mesh.F is a row of mesh.V.
 std::vector<std::pair<int, int>> crossing_face_pairs(const TriMesh& mesh);
 
 /// The pairs of faces (indices into mesh.F, first < second) that intersect, as

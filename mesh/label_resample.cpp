@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -52,6 +53,20 @@ Volume label_occupancy(const Volume& labels, int label, const OccupancyOptions& 
     crop.size[d] = static_cast<std::size_t>(hi[d] - lo[d] + 1 + 2 * margin);
     crop.spacing[d] = labels.spacing[d];
   }
+  // A spacing far from the voxels' (a margin of hundreds of voxels, or a grid far finer than
+  // the image) asks for grids no machine holds: say so before allocating anything.
+  const auto refuse_grid = [&](double voxels) {
+    if (voxels <= kMaxOccupancyGridVoxels) return;
+    char text[64];
+    std::snprintf(text, sizeof text, "%.3g mm makes a grid of %.3g voxels", options.spacing_mm, voxels);
+    throw InputError(std::string("an occupancy grid spacing of ") + text +
+                     " (too many to hold); choose a spacing nearer the image's voxel size, e.g. 1.2 mm");
+  };
+  refuse_grid(static_cast<double>(crop.size[0]) * static_cast<double>(crop.size[1]) * static_cast<double>(crop.size[2]));
+  double output_voxels = 1;
+  for (int d = 0; d < 3; ++d)
+    output_voxels *= std::floor((static_cast<double>(crop.size[d]) - 1) * crop.spacing[d] / options.spacing_mm) + 1;
+  refuse_grid(output_voxels);
   crop.direction = labels.direction;
   crop.origin = labels.index_to_physical(start[0], start[1], start[2]);
   crop.data.assign(crop.num_voxels(), 0.0f);
@@ -61,42 +76,47 @@ Volume label_occupancy(const Volume& labels, int label, const OccupancyOptions& 
         if (labels.at(i, j, k) == target) crop.at(i - start[0], j - start[1], k - start[2]) = 1.0f;
 
   using Image = itk_volume::FloatImage;
-  const Image::Pointer mask = itk_volume::to_itk(crop);
-  auto smooth = itk::SmoothingRecursiveGaussianImageFilter<Image, Image>::New();
-  smooth->SetInput(mask);
-  smooth->SetSigma(sigma);
+  try {
+    const Image::Pointer mask = itk_volume::to_itk(crop);
+    auto smooth = itk::SmoothingRecursiveGaussianImageFilter<Image, Image>::New();
+    smooth->SetInput(mask);
+    smooth->SetSigma(sigma);
 
-  // The output grid: isotropic, the input's direction, covering the crop.
-  Volume out;
-  out.direction = labels.direction;
-  out.origin = crop.origin;
-  out.spacing = {options.spacing_mm, options.spacing_mm, options.spacing_mm};
-  Image::SizeType size;
-  Image::SpacingType spacing;
-  Image::PointType origin;
-  Image::DirectionType direction;
-  for (int d = 0; d < 3; ++d) {
-    const double extent = (static_cast<double>(crop.size[d]) - 1) * crop.spacing[d];
-    out.size[d] = static_cast<std::size_t>(std::floor(extent / options.spacing_mm)) + 1;
-    size[d] = out.size[d];
-    spacing[d] = options.spacing_mm;
-    origin[d] = out.origin[d];
-    for (int c = 0; c < 3; ++c) direction(d, c) = labels.direction[3 * d + c];
+    // The output grid: isotropic, the input's direction, covering the crop.
+    Volume out;
+    out.direction = labels.direction;
+    out.origin = crop.origin;
+    out.spacing = {options.spacing_mm, options.spacing_mm, options.spacing_mm};
+    Image::SizeType size;
+    Image::SpacingType spacing;
+    Image::PointType origin;
+    Image::DirectionType direction;
+    for (int d = 0; d < 3; ++d) {
+      const double extent = (static_cast<double>(crop.size[d]) - 1) * crop.spacing[d];
+      out.size[d] = static_cast<std::size_t>(std::floor(extent / options.spacing_mm)) + 1;
+      size[d] = out.size[d];
+      spacing[d] = options.spacing_mm;
+      origin[d] = out.origin[d];
+      for (int c = 0; c < 3; ++c) direction(d, c) = labels.direction[3 * d + c];
+    }
+    auto resample = itk::ResampleImageFilter<Image, Image>::New();
+    resample->SetInput(smooth->GetOutput());
+    resample->SetTransform(itk::IdentityTransform<double, 3>::New());
+    resample->SetInterpolator(itk::LinearInterpolateImageFunction<Image, double>::New());
+    resample->SetSize(size);
+    resample->SetOutputSpacing(spacing);
+    resample->SetOutputOrigin(origin);
+    resample->SetOutputDirection(direction);
+    resample->SetDefaultPixelValue(0.0f);
+    resample->Update();
+    const float* r = resample->GetOutput()->GetBufferPointer();
+    out.data.assign(r, r + out.num_voxels());
+    for (float& v : out.data) v = std::clamp(v, 0.0f, 1.0f);
+    return out;
+  } catch (const itk::ExceptionObject& e) {
+    throw AlgorithmError(std::string("smoothing and resampling the label failed (") + e.GetDescription() +
+                         "); try another --mc-spacing, or 0 for the voxels' own surface");
   }
-  auto resample = itk::ResampleImageFilter<Image, Image>::New();
-  resample->SetInput(smooth->GetOutput());
-  resample->SetTransform(itk::IdentityTransform<double, 3>::New());
-  resample->SetInterpolator(itk::LinearInterpolateImageFunction<Image, double>::New());
-  resample->SetSize(size);
-  resample->SetOutputSpacing(spacing);
-  resample->SetOutputOrigin(origin);
-  resample->SetOutputDirection(direction);
-  resample->SetDefaultPixelValue(0.0f);
-  resample->Update();
-  const float* r = resample->GetOutput()->GetBufferPointer();
-  out.data.assign(r, r + out.num_voxels());
-  for (float& v : out.data) v = std::clamp(v, 0.0f, 1.0f);
-  return out;
 }
 
 }  // namespace mrsnake

@@ -8,6 +8,9 @@
 
 namespace mrsnake {
 
+/// The largest crop or output grid label_occupancy builds (256 Mi voxels, 1 GiB of floats).
+constexpr double kMaxOccupancyGridVoxels = 256.0 * 1024 * 1024;
+
 struct OccupancyOptions {
   double spacing_mm = 1.2;  ///< isotropic spacing of the output grid
   /// Gaussian sigma (mm) applied to the 0/1 mask before resampling; <= 0: a third of the
@@ -21,7 +24,9 @@ struct OccupancyOptions {
 /// isotropic grid with the input's direction, cropped to the label's bounding box plus a
 /// margin of zeros (so the 0.5 isosurface closes). Values lie in [0, 1].
 /// \pre options.spacing_mm > 0
-/// \throw InputError if no voxel has the label.
+/// \throw InputError if no voxel has the label, or if the crop or the output grid would hold
+///        more than kMaxOccupancyGridVoxels voxels (a spacing far from the image's).
+/// \throw AlgorithmError if ITK fails (e.g. out of memory).
 /// \throw std::invalid_argument if options.spacing_mm is not positive.
 Volume label_occupancy(const Volume& labels, int label, const OccupancyOptions& options = {});
 

@@ -116,8 +116,10 @@ struct ReferenceRegistration {
 /// rejected, with the reason, if ITK fails, if the metric at the result is not better than
 /// at the start, or if the scale leaves [min_scale, max_scale].
 /// `level0_scale`, `level0_offset` normalize pyramid[0] when it holds raw intensities.
-/// \pre pyramid is not empty.
 /// `start_translation` (mm) moves the reference before the registration (default none).
+/// A failed registration (ITK gave up, or the images do not overlap) is reported in the
+/// result as a rejection, not thrown.
+/// \pre pyramid is not empty.
 ReferenceRegistration register_reference(const Volume& reference, const std::vector<const Volume*>& pyramid,
                                          double level0_scale, double level0_offset,
                                          const ReferenceRegistrationOptions& options = {},

@@ -128,7 +128,9 @@ Volume deserialize_reference_image(const std::vector<std::uint8_t>& bytes) {
   std::memcpy(&stored, bytes.data() + expected - 8, 8);
   if (stored != fnv1a64(bytes.data(), expected - 8)) throw defect("was altered or corrupted (its checksum does not match)");
   for (int a = 0; a < 3; ++a)
-    if (!(v.spacing[a] > 0) || !std::isfinite(v.spacing[a]) || !std::isfinite(v.origin[a])) throw defect("has an impossible frame");
+    // Bounds far beyond any scanner's (µm to m voxels, km away) keep index arithmetic finite.
+    if (!(v.spacing[a] >= 1e-3 && v.spacing[a] <= 1e3) || !(std::abs(v.origin[a]) <= 1e7))
+      throw defect("has an impossible frame");
   // The direction must be a rotation or a reflection: orthonormal columns.
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) {

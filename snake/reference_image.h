@@ -32,6 +32,8 @@ struct ReferenceImageOptions {
 Volume make_reference_crop(const Volume& image, const RowMatrixX3d& V, const ReferenceImageOptions& options = {});
 
 /// Binary form (little-endian, versioned, with its own FNV-1a 64 checksum).
+/// \pre reference.data has reference.num_voxels() values; each size is 8..1024 (as the
+///      reader requires: a larger crop would write a section its own reader refuses).
 std::vector<std::uint8_t> serialize_reference_image(const Volume& reference);
 /// \throw InputError if the bytes are truncated, of another format or version, altered
 ///        (checksum), or describe an impossible image (sizes, spacing, direction, values).

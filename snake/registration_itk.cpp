@@ -53,10 +53,10 @@ class TimeGuard : public itk::Command {
  public:
   using Self = TimeGuard;
   using Pointer = itk::SmartPointer<Self>;
-  itkNewMacro(Self);
+  itkNewMacro(Self)
   Optimizer* optimizer = nullptr;
   Clock::time_point start;
-  double max_seconds = 1.0;
+  double max_seconds = 5.0;
   int iterations = 0;
   bool timed_out = false;
   void Execute(itk::Object* caller, const itk::EventObject& event) override { Execute(static_cast<const itk::Object*>(caller), event); }
@@ -189,9 +189,10 @@ bool index_box_of_points(const Volume& image, const std::vector<std::array<doubl
     const double grow = margin_fraction * (mx[a] - mn[a]) + margin_mm / image.spacing[a];
     const long last = static_cast<long>(image.size[a]) - 1;
     const double l = std::floor(mn[a] - grow), h = std::ceil(mx[a] + grow);
-    if (h < 0 || l > last) return false;
-    lo[a] = std::clamp(static_cast<long>(l), 0L, last);
-    hi[a] = std::clamp(static_cast<long>(h), 0L, last);
+    if (!(h >= 0 && l <= last)) return false;  // also false on NaN
+    // Clamp in double first: a far-off point must not overflow the cast to long.
+    lo[a] = static_cast<long>(std::clamp(l, 0.0, static_cast<double>(last)));
+    hi[a] = static_cast<long>(std::clamp(h, 0.0, static_cast<double>(last)));
   }
   return true;
 }
@@ -248,29 +249,31 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
   RegistrationResult result;
   result.moving_crop_size = moving_crop.size;
   result.metric = to_string(o.metric);
-  const auto fixed_image = itk_volume::to_itk(fixed);
-  const auto moving_image = itk_volume::to_itk(moving_crop);
-
-  auto transform = Transform::New();
-  Transform::InputPointType c;
-  for (int a = 0; a < 3; ++a) c[a] = centre[a];
-  transform->SetCenter(c);
-  transform->SetIdentity();
-  transform->SetCenter(c);
-  Transform::OutputVectorType start;
-  for (int a = 0; a < 3; ++a) start[a] = o.initial_translation[a];
-  transform->SetTranslation(start);
-
-  const auto eval_points = grid_points(fixed, 16000);
-  // ITK's own filters inside the registration (smoothing, shrinking, the metric's helpers)
-  // take the global default thread count: o.threads for the span of the registration, so
-  // that it runs on one thread and repeats bit for bit.
-  struct GlobalThreads {
-    itk::ThreadIdType saved = itk::MultiThreaderBase::GetGlobalDefaultNumberOfThreads();
-    explicit GlobalThreads(int n) { itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(static_cast<itk::ThreadIdType>(n)); }
-    ~GlobalThreads() { itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(saved); }
-  } threads(std::max(1, o.threads));
+  // Everything ITK does, setup included, is inside: its exceptions become AlgorithmError,
+  // which segment answers with its fallback route instead of an internal error.
   try {
+    const auto fixed_image = itk_volume::to_itk(fixed);
+    const auto moving_image = itk_volume::to_itk(moving_crop);
+
+    auto transform = Transform::New();
+    Transform::InputPointType c;
+    for (int a = 0; a < 3; ++a) c[a] = centre[a];
+    transform->SetCenter(c);
+    transform->SetIdentity();
+    transform->SetCenter(c);
+    Transform::OutputVectorType start;
+    for (int a = 0; a < 3; ++a) start[a] = o.initial_translation[a];
+    transform->SetTranslation(start);
+
+    const auto eval_points = grid_points(fixed, 16000);
+    // ITK's own filters inside the registration (smoothing, shrinking, the metric's helpers)
+    // take the global default thread count: o.threads for the span of the registration, so
+    // that it runs on one thread and repeats bit for bit.
+    struct GlobalThreads {
+      itk::ThreadIdType saved = itk::MultiThreaderBase::GetGlobalDefaultNumberOfThreads();
+      explicit GlobalThreads(int n) { itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(static_cast<itk::ThreadIdType>(n)); }
+      ~GlobalThreads() { itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(saved); }
+    } threads(std::max(1, o.threads));
     const auto t_eval = Clock::now();
     result.initial_metric =
         evaluate_metric(o, fixed_image, moving_image, transform, eval_points, &result.valid_points_initial);
@@ -279,7 +282,7 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
     const auto t_opt = Clock::now();
 
     auto metric = make_metric(o);
-    // One work unit: one thread, and sums in one order, so that a run repeats bit for bit.
+    // o.threads work units (1 by default: sums in one order, so that a run repeats bit for bit).
     metric->SetMaximumNumberOfWorkUnits(static_cast<itk::ThreadIdType>(std::max(1, o.threads)));
     auto optimizer = Optimizer::New();
     optimizer->SetLearningRate(o.initial_step_mm);
@@ -332,7 +335,7 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
     // Iterations per level: the optimizer restarts its count at each level.
     struct LevelCounter : public itk::Command {
       using Pointer = itk::SmartPointer<LevelCounter>;
-      itkNewMacro(LevelCounter);
+      itkNewMacro(LevelCounter)
       TimeGuard* guard = nullptr;
       Optimizer* optimizer = nullptr;
       std::vector<int>* per_level = nullptr;

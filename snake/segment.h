@@ -80,7 +80,8 @@ struct SegmentOptions {
   double fit_min_range_voxels = 4.0;  ///< the initial fit's search range is at least this many voxels
   double step_voxels = 0.5;       ///< search step, in voxels of the pyramid level
   double profile_step_fraction = 0.5;  ///< profile search step, as a fraction of the profile spacing
-  /// Fine levels: the search range is at most this many voxels of the pyramid level (0: no cap).
+  /// The search range is at most this many voxels of the pyramid level (0: no cap), on the
+  /// levels and in the initial fit.
   double max_range_voxels = 0;
   double window_voxels = 2.0;     ///< step_edge half window, in voxels of the pyramid level
   double edge_per_voxel = 2.0;    ///< pyramid level choice (appearance.h)
@@ -126,7 +127,8 @@ struct SegmentResult {
 };
 
 /// Segments `image` (any spacing and direction; not modified) with the model.
-/// \throw InputError if the model has no levels or its appearance does not match it.
+/// \throw InputError if the model has no levels or its appearance does not match it, or if
+///        options ask for --init register without a reference image in the model.
 /// \throw AlgorithmError if the initialization finds nothing to align to.
 SegmentResult segment(const Volume& image, const SnakeModel& model, const SegmentOptions& options = {},
                       const ProgressFn& progress = {});

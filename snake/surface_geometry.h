@@ -39,6 +39,7 @@ void smooth_on_rings(const VertexRings& rings, Eigen::VectorXd& values, int pass
 
 /// Replaces each value by the median over the vertex and its ring, `passes` times (an
 /// outlier among its neighbours, e.g. a false profile match, does not move a vertex).
+/// \pre values has one entry per vertex of rings.
 void median_on_rings(const VertexRings& rings, Eigen::VectorXd& values, int passes);
 
 }  // namespace mrsnake

@@ -165,6 +165,11 @@ TEST(MarchingCubes, OccupancyIsInZeroOneAndClosesAtTheBorder) {
   EXPECT_THROW(label_occupancy(labels, 3, o), InputError);
   o.spacing_mm = 0;
   EXPECT_THROW(label_occupancy(labels, 2, o), std::invalid_argument);
+  // Spacings far from the voxels' would need grids of billions of voxels: refused up front.
+  o.spacing_mm = 1e-4;  // 12 mm / 1e-4 mm = 120,000 cells per axis
+  EXPECT_THROW(label_occupancy(labels, 2, o), InputError);
+  o.spacing_mm = 500;  // a margin of about 1,300 voxels per side
+  EXPECT_THROW(label_occupancy(labels, 2, o), InputError);
 }
 
 TEST(MarchingCubes, KeepsTheLargestComponentAndReportsTheOthers) {

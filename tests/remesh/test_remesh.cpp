@@ -89,7 +89,9 @@ void expect_nested_and_valid(const RemeshResult& r, const TriMesh& input, bool c
       EXPECT_EQ(conn.faces[j].rows(), 4 * conn.faces[j - 1].rows());
       const auto previous_edges = edges_of(conn.faces[j - 1]);
       EXPECT_EQ(conn.vertex_count(j), conn.vertex_count(j - 1) + static_cast<int>(previous_edges.size()));
-      if (closed) EXPECT_EQ(2 * static_cast<int>(previous_edges.size()), 3 * static_cast<int>(conn.faces[j - 1].rows()));
+      if (closed) {
+        EXPECT_EQ(2 * static_cast<int>(previous_edges.size()), 3 * static_cast<int>(conn.faces[j - 1].rows()));
+      }
       // Every new vertex records an edge of the previous level as its parent.
       for (int v = conn.vertex_count(j - 1); v < conn.vertex_count(j); ++v) {
         const Eigen::Vector2i p = conn.parents(v);
