@@ -15,27 +15,14 @@
 #include "remesh/convex_hull.h"
 #include "remesh/remesh.h"
 #include "remesh/simplify.h"
+#include "tests/remesh/remesh_shapes.h"
 #include "tests/test_support.h"
 
 namespace mrsnake {
 namespace {
 
-TriMesh stretched_sphere(int levels) {
-  TriMesh m = icosphere(levels);
-  m.V.col(0) *= 3.0;
-  m.V.col(1) *= 1.5;
-  return m;
-}
-
-TriMesh flattened_cap(int levels) {
-  const TriMesh s = icosphere(levels);
-  std::vector<int> faces;
-  for (int f = 0; f < s.num_faces(); ++f)
-    if (s.V(s.F(f, 0), 2) + s.V(s.F(f, 1), 2) + s.V(s.F(f, 2), 2) < 0.9) faces.push_back(f);
-  TriMesh cap = extract_faces(s, faces);
-  cap.V.col(0) *= 2.0;
-  return cap;
-}
+using test::ellipsoid;
+using test::spherical_cap;
 
 // Every level's 3D and domain positions and its statistics (timings aside) are identical.
 void expect_identical(const RemeshResult& a, const RemeshResult& b) {
@@ -68,11 +55,11 @@ TEST(RemeshDeterminism, SameInputTwiceInOneProcessGivesIdenticalLevels) {
   o.base_vertices = 24;
   {
     SCOPED_TRACE("sphere");
-    expect_repeatable(stretched_sphere(4), o);
+    expect_repeatable(ellipsoid(4), o);
   }
   {
     SCOPED_TRACE("disk");
-    expect_repeatable(flattened_cap(4), o);
+    expect_repeatable(spherical_cap(4), o);
   }
 }
 
@@ -107,7 +94,7 @@ TEST(RemeshDeterminism, ConvexHullFacesComeInCanonicalOrder) {
 }
 
 TEST(RemeshDeterminism, SimplificationIsRepeatable) {
-  const TriMesh input = stretched_sphere(4);
+  const TriMesh input = ellipsoid(4);
   const TriMesh first = simplify_to_faces(input, 1000);
   for (int run = 0; run < 3; ++run) {
     const TriMesh again = simplify_to_faces(input, 1000);

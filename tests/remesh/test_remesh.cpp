@@ -22,31 +22,14 @@
 #include "remesh/remesh.h"
 #include "remesh/sizing.h"
 #include "remesh/triangle_repair.h"
+#include "tests/remesh/remesh_shapes.h"
 #include "tests/test_support.h"
 
 namespace mrsnake {
 namespace {
 
-// An ellipsoid with semi-axes 3, 1.5, 1 (stretches the sphere unevenly).
-TriMesh ellipsoid(int levels) {
-  TriMesh m = icosphere(levels);
-  m.V.col(0) *= 3.0;
-  m.V.col(1) *= 1.5;
-  return m;
-}
-
-// A disk: the part of an icosphere with z < 0.3, slightly flattened.
-TriMesh spherical_cap(int levels) {
-  const TriMesh s = icosphere(levels);
-  std::vector<int> faces;
-  for (int f = 0; f < s.num_faces(); ++f) {
-    const double z = (s.V(s.F(f, 0), 2) + s.V(s.F(f, 1), 2) + s.V(s.F(f, 2), 2)) / 3;
-    if (z < 0.3) faces.push_back(f);
-  }
-  TriMesh cap = extract_faces(s, faces);
-  cap.V.col(0) *= 2.0;
-  return cap;
-}
+using test::ellipsoid;
+using test::spherical_cap;
 
 std::set<std::pair<int, int>> edges_of(const RowMatrixX3i& F) {
   std::set<std::pair<int, int>> e;
