@@ -145,7 +145,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   report(progress, "normalize", 0.0);
   // The full-resolution image is not copied: its sampler normalizes on the fly, and only
   // the (8× smaller and below) pyramid levels are stored normalized.
-  result.window = robust_intensity_window(image);
+  result.window = robust_intensity_window(image, 1.0, 99.0, std::max<std::size_t>(1024, options.intensity_samples));
   const double norm_scale = 1.0 / (result.window.high - result.window.low);
   const double norm_offset = -result.window.low * norm_scale;
   end_stage("normalize");
