@@ -57,6 +57,11 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   if (options.levels == 0 && options.target_faces < 16) throw std::invalid_argument("target_faces must be at least 16");
   if (options.lloyd_iterations < 0) throw std::invalid_argument("lloyd_iterations must be >= 0");
   if (options.shape_iterations < 0) throw std::invalid_argument("shape_iterations must be >= 0");
+  if (options.surface_relax_iterations < 0) throw std::invalid_argument("surface_relax_iterations must be >= 0");
+  if (!(options.surface_relax_quality_floor >= 0 && options.surface_relax_quality_floor <= 1))
+    throw std::invalid_argument("surface_relax_quality_floor must be in [0, 1]");
+  if (!(options.curvature_exponent > 0 && options.curvature_exponent <= 4))
+    throw std::invalid_argument("curvature_exponent must be in (0, 4]");
   if (options.repair_sweeps < 0) throw std::invalid_argument("repair_sweeps must be >= 0");
   if (!(options.repair_threshold > 0 && options.repair_threshold <= 1))
     throw std::invalid_argument("repair_threshold must be in (0, 1]");
@@ -119,7 +124,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     const double mean = kappa.mean();
     // Capped, so that a few sharp spots (voxel steps of a marching-cubes surface) cannot pull
     // the spacing down so fast that triangle shapes suffer.
-    if (mean > 0) wanted.array() += options.curvature_weight * (kappa.array() / mean).min(3.0);
+    if (mean > 0) wanted.array() += options.curvature_weight * (kappa.array() / mean).pow(options.curvature_exponent).min(3.0);
   }
   DensityField density{&domain_mesh,
                        param.vertex_stretch.cwiseProduct(wanted).array().pow(options.density_exponent).matrix()};
@@ -156,7 +161,14 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       const int rounds = options.shape_iterations;
       ShapeSmoothingOptions shape;
       shape.iterations = 1;
+      shape.move_rim = options.smooth_rim;
       lloyd.first_movable = 0;
+      ShapeSmoothingOptions surface;
+      surface.iterations = options.surface_relax_iterations;
+      surface.target = SmoothingTarget::area_centroid;
+      surface.surface_density = &wanted;
+      surface.move_rim = options.smooth_rim;
+      surface.quality_floor = options.surface_relax_quality_floor;
       for (int round = 0; round < rounds; ++round) {
         lloyd.iterations = options.lloyd_iterations * (round + 1) / rounds - options.lloyd_iterations * round / rounds;
         const LloydStats s = constrained_lloyd(kind, F, density, U, hints, lloyd);
@@ -167,6 +179,10 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
         level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
         shape_moves += smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, shape);
       }
+      // Sizes last: the area-centroid target evens out what the Lloyd step in D left uneven
+      // where the stretch changes fast; its quality floor keeps the shapes just made.
+      if (surface.iterations > 0)
+        shape_moves += smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, surface);
     } else {
       const bool relax = options.relax == RelaxMode::all_vertices ||
                          (options.relax == RelaxMode::new_vertices_only && j > 0);
@@ -240,6 +256,10 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["relax"] = relax_name(options.relax);
   j["density_exponent"] = options.density_exponent;
   j["curvature_weight"] = options.curvature_weight;
+  j["curvature_exponent"] = options.curvature_exponent;
+  j["surface_relax_iterations"] = options.relax == RelaxMode::all_vertices ? options.surface_relax_iterations : 0;
+  j["surface_relax_quality_floor"] = options.surface_relax_quality_floor;
+  j["smooth_rim"] = options.smooth_rim;
   j["lloyd_iterations"] = options.lloyd_iterations;
   j["shape_iterations"] = options.relax == RelaxMode::all_vertices ? options.shape_iterations : 0;
   j["repair_sweeps"] = options.relax == RelaxMode::all_vertices ? options.repair_sweeps : 0;
