@@ -29,6 +29,8 @@ void add_remesh_command(CLI::App& app) {
     int surface_relax_iterations = RemeshOptions{}.surface_relax_iterations;
     double surface_relax_floor = RemeshOptions{}.surface_relax_quality_floor;
     bool smooth_rim = RemeshOptions{}.smooth_rim;
+    double base_density_exponent = RemeshOptions{}.base_density_exponent;
+    int base_density_smoothing = RemeshOptions{}.base_density_smoothing;
   };
   auto args = std::make_shared<Args>();
   cmd->add_option("MESH", args->mesh, "Input surface (.vtp .vtk .stl .ply .obj .off): a disk or a closed genus-0 surface")
@@ -65,6 +67,14 @@ void add_remesh_command(CLI::App& app) {
   cmd->add_flag("--smooth-rim,!--no-smooth-rim", args->smooth_rim,
                 std::string("Disk inputs: rim vertices slide along the rim during smoothing (default ") +
                     (RemeshOptions{}.smooth_rim ? "on" : "off") + ")");
+  cmd->add_option("--base-density-exponent", args->base_density_exponent,
+                  "Base vertices closer where the surface bends: farthest-point distances scaled by the curvature sizing^e "
+                  "(default " + std::to_string(RemeshOptions{}.base_density_exponent).substr(0, 4) + "; 0 = even)")
+      ->check(CLI::Range(0.0, 4.0));
+  cmd->add_option("--base-density-smoothing", args->base_density_smoothing,
+                  "Passes of 1-ring averaging of that density first (default " +
+                      std::to_string(RemeshOptions{}.base_density_smoothing) + "; -1 = about one base spacing)")
+      ->check(CLI::Range(-1, 1000));
   cmd->add_option("--iterations", args->iterations, "Lloyd iterations per level (default 8)")->check(CLI::Range(0, 1000));
   cmd->add_option("--shape-iterations", args->shape_iterations,
                   "Iterations per level of 3D shape smoothing after Lloyd (default " + std::to_string(RemeshOptions{}.shape_iterations) + "; not with --strict or --no-relax)")
@@ -109,6 +119,8 @@ void add_remesh_command(CLI::App& app) {
     options.surface_relax_iterations = args->surface_relax_iterations;
     options.surface_relax_quality_floor = args->surface_relax_floor;
     options.smooth_rim = args->smooth_rim;
+    options.base_density_exponent = args->base_density_exponent;
+    options.base_density_smoothing = args->base_density_smoothing;
     options.relax = args->no_relax ? RelaxMode::none : args->strict ? RelaxMode::new_vertices_only : RelaxMode::all_vertices;
     if (!global_options().quiet) options.progress = terminal_progress();
     const RemeshResult result = remesh(input, options);
