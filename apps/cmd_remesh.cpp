@@ -31,6 +31,7 @@ void add_remesh_command(CLI::App& app) {
     bool smooth_rim = RemeshOptions{}.smooth_rim;
     double base_density_exponent = RemeshOptions{}.base_density_exponent;
     int base_density_smoothing = RemeshOptions{}.base_density_smoothing;
+    int snap_tips = RemeshOptions{}.snap_tips;
   };
   auto args = std::make_shared<Args>();
   cmd->add_option("MESH", args->mesh, "Input surface (.vtp .vtk .stl .ply .obj .off): a disk or a closed genus-0 surface")
@@ -75,6 +76,10 @@ void add_remesh_command(CLI::App& app) {
                   "Passes of 1-ring averaging of that density first (default " +
                       std::to_string(RemeshOptions{}.base_density_smoothing) + "; -1 = about one base spacing)")
       ->check(CLI::Range(-1, 1000));
+  cmd->add_option("--snap-tips", args->snap_tips,
+                  "Finest level: up to this many vertices snap onto the input's vertices farthest from it (default " +
+                      std::to_string(RemeshOptions{}.snap_tips) + "; 0 = off)")
+      ->check(CLI::Range(0, 100000));
   cmd->add_option("--iterations", args->iterations, "Lloyd iterations per level (default 8)")->check(CLI::Range(0, 1000));
   cmd->add_option("--shape-iterations", args->shape_iterations,
                   "Iterations per level of 3D shape smoothing after Lloyd (default " + std::to_string(RemeshOptions{}.shape_iterations) + "; not with --strict or --no-relax)")
@@ -121,6 +126,7 @@ void add_remesh_command(CLI::App& app) {
     options.smooth_rim = args->smooth_rim;
     options.base_density_exponent = args->base_density_exponent;
     options.base_density_smoothing = args->base_density_smoothing;
+    options.snap_tips = args->snap_tips;
     options.relax = args->no_relax ? RelaxMode::none : args->strict ? RelaxMode::new_vertices_only : RelaxMode::all_vertices;
     if (!global_options().quiet) options.progress = terminal_progress();
     const RemeshResult result = remesh(input, options);

@@ -12,6 +12,7 @@
 #include "mesh/quality.h"
 #include "remesh/base_mesh.h"
 #include "remesh/domain.h"
+#include "remesh/feature_snap.h"
 #include "remesh/lift.h"
 #include "remesh/lloyd.h"
 #include "remesh/parameterization.h"
@@ -68,6 +69,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   if (!(options.base_density_exponent >= 0 && options.base_density_exponent <= 4))
     throw std::invalid_argument("base_density_exponent must be in [0, 4]");
   if (options.base_density_smoothing < -1) throw std::invalid_argument("base_density_smoothing must be >= -1");
+  if (options.snap_tips < 0) throw std::invalid_argument("snap_tips must be >= 0");
   if (options.surface_relax_iterations < 0) throw std::invalid_argument("surface_relax_iterations must be >= 0");
   if (!(options.surface_relax_quality_floor >= 0 && options.surface_relax_quality_floor <= 1))
     throw std::invalid_argument("surface_relax_quality_floor must be in [0, 1]");
@@ -214,6 +216,12 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       }
       level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
     }
+    int snapped = 0;
+    if (options.relax == RelaxMode::all_vertices && options.snap_tips > 0 && j == levels) {
+      FeatureSnapOptions snap;
+      snap.max_snaps = options.snap_tips;
+      snapped = snap_to_input_tips(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, snap);
+    }
     // Onto the original input before the repair, so that the repair sees (and keeps) the
     // final triangles: the projection onto a marching-cubes staircase shears a few of them.
     const bool project_first = reproject && options.repair_after_reprojection;
@@ -249,6 +257,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     s["lloyd_last_mean_shift"] = relax_stats.mean_shift;
     s["shape_moves"] = shape_moves;
     s["repair_moves"] = repair.moves;
+    s["snapped_vertices"] = snapped;
     if (repair.moves > 0) {
       s["repair_q_min_before"] = repair.q_min_before;
       s["repair_q_min_after"] = repair.q_min_after;
@@ -285,6 +294,7 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["smooth_rim"] = options.smooth_rim;
   j["base_density_exponent"] = options.base_density_exponent;
   j["repair_after_reprojection"] = options.repair_after_reprojection;
+  j["snap_tips"] = options.relax == RelaxMode::all_vertices ? options.snap_tips : 0;
   j["base_density_smoothing"] = options.base_density_smoothing;
   j["lloyd_iterations"] = options.lloyd_iterations;
   j["shape_iterations"] = options.relax == RelaxMode::all_vertices ? options.shape_iterations : 0;

@@ -87,6 +87,10 @@ struct RemeshOptions {
   bool repair_guard_finest = true;
   /// The guard lets triangles move away from the surface by up to this x the mean edge length.
   double repair_error_tolerance = 0.03;
+  /// With all_vertices, on the finest level: up to this many vertices snap onto the input's
+  /// vertices farthest from the level (its tips, which the Lloyd steps cut off), before the
+  /// repair (remesh/feature_snap.h). 0 = off.
+  int snap_tips = 32;
   /// With a simplified input: project each level onto the original input before the repair
   /// (which then moves vertices on the original) instead of after it, so the repair sees the
   /// triangles the projection shears (on the liver's staircase it cost Q min 0.59).

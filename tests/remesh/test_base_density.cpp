@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "mesh/distance.h"
@@ -11,6 +12,7 @@
 #include "mesh/quality.h"
 #include "remesh/base_mesh.h"
 #include "remesh/domain.h"
+#include "remesh/feature_snap.h"
 #include "remesh/lift.h"
 #include "remesh/parameterization.h"
 #include "remesh/sizing.h"
@@ -103,6 +105,47 @@ TEST(TriangleRepair, ProjectsItsMovesOntoTheOriginalInput) {
   EXPECT_NEAR(stats.q_min_after, mesh_quality(TriMesh{X, F}).q_min, 1e-12);
   EXPECT_LT(on_fine.distances(X).maxCoeff(), 1e-9 * diag);
   EXPECT_EQ(count_flipped(U, F), 0);
+}
+
+// Tip snapping: on a coarse even layout of the ellipsoid, whose long-axis ends it cuts off,
+// vertices snap exactly onto input vertices, the largest input-to-level distance goes down,
+// nothing flips, and every snapped vertex's triangles keep the quality and angle bounds.
+TEST(FeatureSnap, SnapsVerticesOntoTheTipsTheLevelCutsOff) {
+  const TriMesh input = ellipsoid(4);
+  const Parameterization param = parameterize(input);
+  const DomainMesh domain(param.domain, param.surface.F);
+  const TriMesh grid = icosphere(2);
+  RowMatrixX3d U = grid.V.rowwise().normalized();
+  const RowMatrixX3i& F = grid.F;
+  std::vector<int> hints(U.rows(), 0);
+  RowMatrixX3d X = lift_to_surface(domain, param.surface.V, U, hints);
+  const RowMatrixX3d X0 = X;
+  const double before = SurfaceLocator(TriMesh{X, F}).distances(param.surface.V).maxCoeff();
+  FeatureSnapOptions options;
+  const int snaps = snap_to_input_tips(DomainKind::sphere, F, domain, param.surface.V, U, X, hints, options);
+  EXPECT_GT(snaps, 0);
+  EXPECT_LE(snaps, options.max_snaps);
+  EXPECT_EQ(count_flipped(U, F), 0);
+  const double after = SurfaceLocator(TriMesh{X, F}).distances(param.surface.V).maxCoeff();
+  EXPECT_LT(after, before);
+  std::vector<int> fresh(U.rows(), 0);
+  EXPECT_LT((lift_to_surface(domain, param.surface.V, U, fresh) - X).cwiseAbs().maxCoeff(), 1e-9);
+  int moved = 0;
+  for (int v = 0; v < X.rows(); ++v) {
+    if (X.row(v) == X0.row(v)) continue;
+    ++moved;
+    // Exactly an input vertex.
+    double nearest = std::numeric_limits<double>::infinity();
+    for (int s = 0; s < param.surface.num_vertices(); ++s) nearest = std::min(nearest, (param.surface.V.row(s) - X.row(v)).norm());
+    EXPECT_EQ(nearest, 0.0);
+    for (int f = 0; f < F.rows(); ++f) {
+      if (F(f, 0) != v && F(f, 1) != v && F(f, 2) != v) continue;
+      const QualityReport q = mesh_quality(TriMesh{X, RowMatrixX3i(F.row(f))});
+      EXPECT_GE(q.q_min, options.min_quality - 1e-12);
+      EXPECT_GE(q.min_angle_deg, options.min_angle_deg - 1e-9);
+    }
+  }
+  EXPECT_EQ(moved, snaps);
 }
 
 }  // namespace
