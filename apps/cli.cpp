@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <iostream>
 
@@ -20,6 +22,20 @@ void info(const std::string& message) {
 void warn(const std::string& message) { std::cerr << "mrsnake: warning: " << message << '\n'; }
 
 void print_json(const nlohmann::json& j) { std::cout << j.dump(2) << std::endl; }
+
+void refuse_non_finite_numbers(CLI::App& app) {
+  const CLI::Validator finite(
+      [](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        if (end != text.c_str() && !std::isfinite(value)) return "needs a finite number, not '" + text + "'";
+        return {};
+      },
+      "", "finite");
+  for (CLI::Option* option : app.get_options())
+    if (option->get_type_name().rfind("FLOAT", 0) == 0) option->check(finite);
+  for (CLI::App* command : app.get_subcommands([](CLI::App*) { return true; })) refuse_non_finite_numbers(*command);
+}
 
 ProgressFn terminal_progress() {
   if (global_options().quiet) return {};

@@ -40,4 +40,9 @@ void add_remesh_command(CLI::App& app);
 void add_build_model_command(CLI::App& app);
 void add_segment_command(CLI::App& app);
 
+/// Makes every FLOAT option of app and its subcommands refuse nan and inf with a usage error
+/// (CLI11's Range lets nan through: every comparison with it is false). Call after the
+/// commands are added.
+void refuse_non_finite_numbers(CLI::App& app);
+
 }  // namespace mrsnake::cli

@@ -68,6 +68,10 @@ int main(int argc, char** argv) {
       reg.shrink_factors.clear();
       reg.smoothing_voxels.clear();
       for (const char c : a.substr(eq + 1)) {
+        if (c < '1' || c > '9') {
+          std::fprintf(stderr, "reg_schedule takes shrink factors as digits 1-9, e.g. 421; got '%c'\n", c);
+          return 2;
+        }
         reg.shrink_factors.push_back(c - '0');
         reg.smoothing_voxels.push_back(0.5 * (c - '0') >= 1 ? 0.5 * (c - '0') : 0.0);
       }

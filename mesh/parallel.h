@@ -17,6 +17,7 @@ namespace detail {
 /// The loop of parallel_ranges with the thread start passed in, so that a test can make it fail.
 /// A range whose thread cannot be started (std::system_error: no resources) runs on the calling
 /// thread instead, so the loop degrades to fewer threads rather than terminating the program.
+/// \pre parts >= 1 when n > 0; start_thread returns a joinable std::thread running its argument.
 template <class F, class StartThread>
 void parallel_ranges_with(std::size_t n, std::size_t parts, F& f, StartThread&& start_thread) {
   if (parts <= 1) {
@@ -37,7 +38,7 @@ void parallel_ranges_with(std::size_t n, std::size_t parts, F& f, StartThread&& 
   for (; started < parts; ++started) {
     try {
       pool.push_back(start_thread([&run, started] { run(started); }));
-    } catch (const std::system_error&) {
+    } catch (...) {  // std::system_error (no resources) or std::bad_alloc
       break;
     }
   }
@@ -53,6 +54,7 @@ void parallel_ranges_with(std::size_t n, std::size_t parts, F& f, StartThread&& 
 /// Runs f(begin, end) on contiguous ranges of [0, n), one per hardware thread (at most
 /// max_threads), each at least min_per_thread long; rethrows the first exception. The range
 /// starting at 0 runs on the calling thread.
+/// \throw whatever f throws (the first range's exception, in range order), after every range ends.
 /// \pre f may run concurrently on disjoint ranges.
 template <class F>
 void parallel_ranges(std::size_t n, F&& f, std::size_t min_per_thread = 1024, std::size_t max_threads = 8) {

@@ -23,11 +23,18 @@ IntensityWindow robust_intensity_window(const Volume& volume, double low_percent
                                         std::size_t max_samples) {
   const std::size_t n = volume.data.size();
   if (n == 0) throw InputError("the image is empty; give a 3D image with voxels");
-  const std::size_t stride = std::max<std::size_t>(1, n / std::max<std::size_t>(1, max_samples));
+  // A 3D lattice with the same step on every axis, centred in its cells: a stride along the
+  // flat index would fall on a few x planes whenever it divides the row length.
+  const double ratio = static_cast<double>(n) / static_cast<double>(std::max<std::size_t>(1, max_samples));
+  const std::size_t step = ratio > 1 ? static_cast<std::size_t>(std::max(1.0, std::floor(std::cbrt(ratio)))) : 1;
   std::vector<float> samples;
-  samples.reserve(n / stride + 1);
-  for (std::size_t i = 0; i < n; i += stride)
-    if (std::isfinite(volume.data[i])) samples.push_back(volume.data[i]);
+  samples.reserve(n / (step * step * step) + 1);
+  for (std::size_t k = (std::min(step, volume.size[2]) - 1) / 2; k < volume.size[2]; k += step)
+    for (std::size_t j = (std::min(step, volume.size[1]) - 1) / 2; j < volume.size[1]; j += step)
+      for (std::size_t i = (std::min(step, volume.size[0]) - 1) / 2; i < volume.size[0]; i += step) {
+        const float value = volume.at(i, j, k);
+        if (std::isfinite(value)) samples.push_back(value);
+      }
   if (samples.empty()) throw InputError("the image has no finite intensity");
   const auto percentile = [&](double pct) {
     const std::size_t k = static_cast<std::size_t>(std::llround(pct / 100.0 * static_cast<double>(samples.size() - 1)));

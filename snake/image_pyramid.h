@@ -24,7 +24,7 @@ IntensityWindow robust_intensity_window(const Volume& volume, double low_percent
 void apply_intensity_window(Volume& volume, const IntensityWindow& window);
 
 /// Robust normalization: the low and high percentiles of the intensities (estimated on at
-/// most max_samples voxels taken on a regular stride) map to 0 and 1, linearly; values
+/// most about max_samples voxels on a regular 3D lattice) map to 0 and 1, linearly; values
 /// outside are kept (not clipped), so bright outliers stay bright.
 /// \pre 0 <= low_percentile < high_percentile <= 100; volume not empty.
 /// \throw InputError if the image is constant (nothing to segment).

@@ -193,3 +193,19 @@ TEST_F(Robustness, TruncatedUncompressedImage) {
   expect_one_line_error(run_mrsnake("mc --labels " + path("short.nii") + " --label 1 -o " + path("t.vtp")), 3,
                         "truncated");
 }
+
+TEST(CommandLine, NonFiniteNumbersAreUsageErrors) {
+  // CLI11's ranges let nan through (every comparison with it is false); every FLOAT option of
+  // every command must refuse nan and inf with a one-line usage error (exit 2) naming the option.
+  const std::string out = mrsnake::test::scratch_dir("non-finite").string();
+  for (const std::string& args :
+       {"remesh in.off -o " + out + "/r --repair-threshold nan", "remesh in.off -o " + out + "/r --density-exponent NaN",
+        "synth -o " + out + "/s --snr inf", "synth -o " + out + "/s --blur -inf",
+        "build-model --labels l.nii.gz --label 1 -o " + out + "/m --mc-spacing nan"}) {
+    const auto r = run_mrsnake(args);
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.output;
+    EXPECT_NE(r.output.find("needs a finite number"), std::string::npos) << args << "\n" << r.output;
+    EXPECT_EQ(r.output.find("internal error"), std::string::npos) << args << "\n" << r.output;
+  }
+  EXPECT_TRUE(fs::is_empty(out));
+}

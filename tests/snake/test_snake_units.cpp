@@ -151,6 +151,21 @@ TEST(Pyramid, TheSegmentsIntensitySubsampleGivesTheFullImagesWindow) {
   EXPECT_NEAR(sub.high, all.high, 0.01 * width);
 }
 
+TEST(Pyramid, TheIntensitySubsampleSeesEveryPartOfARow) {
+  // A bright slab of 8 x planes (12.5 % of the voxels) in a 64-voxel row: a stride of 16 along
+  // the flat index would only ever read x = 0, 16, 32, 48 and miss it; the 3D lattice must not.
+  Volume v = make_grid({64, 32, 32}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
+  for (std::size_t k = 0; k < 32; ++k)
+    for (std::size_t j = 0; j < 32; ++j)
+      for (std::size_t i = 0; i < 64; ++i) v.at(i, j, k) = (i >= 1 && i <= 8) ? 10.0f : static_cast<float>(i % 3);
+  const std::size_t max_samples = v.data.size() / 16;
+  const IntensityWindow all = robust_intensity_window(v, 1.0, 99.0, v.data.size());
+  const IntensityWindow sub = robust_intensity_window(v, 1.0, 99.0, max_samples);
+  EXPECT_EQ(all.high, 10.0);
+  EXPECT_EQ(sub.high, 10.0);
+  EXPECT_EQ(sub.low, all.low);
+}
+
 TEST(Rasterize, SphereMatchesTheLatticeWithObliqueDirection) {
   const Eigen::Matrix3d D = rotation(35, {1, -1, 2});
   const Volume grid = make_grid({40, 36, 30}, {0.8, 0.9, 1.1}, {-12, -14, -11}, D);
