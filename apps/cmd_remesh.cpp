@@ -19,12 +19,19 @@ void add_remesh_command(CLI::App& app) {
                                  "(level_0.vtp ... level_L.vtp, report.json and report.html)");
   struct Args {
     std::string mesh, out;
-    int levels = 0, faces = 16000, base_vertices = 32, iterations = 8, shape_iterations = 3;
+    int levels = 0, faces = 16000, base_vertices = 32, iterations = 8, shape_iterations = RemeshOptions{}.shape_iterations;
     int repair_sweeps = RemeshOptions{}.repair_sweeps, rim_min_triangles = RemeshOptions{}.rim_min_triangles;
     double exponent = 2.0, curvature = 1.0, repair_threshold = RemeshOptions{}.repair_threshold;
     double repair_tolerance = RemeshOptions{}.repair_error_tolerance;
     bool no_relax = false, strict = false, json = false, compare_unrelaxed = false;
     bool repair_finest_only = false, repair_no_guard = false;
+    double curvature_exponent = RemeshOptions{}.curvature_exponent;
+    int surface_relax_iterations = RemeshOptions{}.surface_relax_iterations;
+    double surface_relax_floor = RemeshOptions{}.surface_relax_quality_floor;
+    bool smooth_rim = RemeshOptions{}.smooth_rim;
+    double base_density_exponent = RemeshOptions{}.base_density_exponent;
+    int base_density_smoothing = RemeshOptions{}.base_density_smoothing;
+    int snap_tips = RemeshOptions{}.snap_tips;
   };
   auto args = std::make_shared<Args>();
   cmd->add_option("MESH", args->mesh, "Input surface (.vtp .vtk .stl .ply .obj .off): a disk or a closed genus-0 surface")
@@ -46,15 +53,42 @@ void add_remesh_command(CLI::App& app) {
       ->check(CLI::Range(0.0, 8.0));
   cmd->add_option("--curvature-weight", args->curvature, "Denser where the surface bends: 3D density 1 + w·κ/mean κ (default 1; 0 = even spacing)")
       ->check(CLI::Range(0.0, 100.0));
+  cmd->add_option("--curvature-exponent", args->curvature_exponent,
+                  "Curvature sizing exponent p: 3D density 1 + w·(κ/mean κ)^p (default " +
+                      std::to_string(RemeshOptions{}.curvature_exponent).substr(0, 4) + ")")
+      ->check(CLI::Range(0.01, 4.0));
+  cmd->add_option("--surface-relax-iterations", args->surface_relax_iterations,
+                  "Iterations per level of tangential relaxation on the surface after the shape smoothing (default " +
+                      std::to_string(RemeshOptions{}.surface_relax_iterations) + "; 0 = off)")
+      ->check(CLI::Range(0, 1000));
+  cmd->add_option("--surface-relax-floor", args->surface_relax_floor,
+                  "Surface relaxation moves may not lower a vertex's worst triangle quality below min(before, this) (default " +
+                      std::to_string(RemeshOptions{}.surface_relax_quality_floor).substr(0, 4) + "; 0 = no check)")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_flag("--smooth-rim,!--no-smooth-rim", args->smooth_rim,
+                std::string("Disk inputs: rim vertices slide along the rim during smoothing (default ") +
+                    (RemeshOptions{}.smooth_rim ? "on" : "off") + ")");
+  cmd->add_option("--base-density-exponent", args->base_density_exponent,
+                  "Base vertices closer where the surface bends: farthest-point distances scaled by the curvature sizing^e "
+                  "(default " + std::to_string(RemeshOptions{}.base_density_exponent).substr(0, 4) + "; 0 = even)")
+      ->check(CLI::Range(0.0, 4.0));
+  cmd->add_option("--base-density-smoothing", args->base_density_smoothing,
+                  "Passes of 1-ring averaging of that density first (default " +
+                      std::to_string(RemeshOptions{}.base_density_smoothing) + "; -1 = about one base spacing)")
+      ->check(CLI::Range(-1, 1000));
+  cmd->add_option("--snap-tips", args->snap_tips,
+                  "Finest level: up to this many vertices snap onto the input's vertices farthest from it (default " +
+                      std::to_string(RemeshOptions{}.snap_tips) + "; 0 = off)")
+      ->check(CLI::Range(0, 100000));
   cmd->add_option("--iterations", args->iterations, "Lloyd iterations per level (default 8)")->check(CLI::Range(0, 1000));
   cmd->add_option("--shape-iterations", args->shape_iterations,
-                  "Iterations per level of 3D shape smoothing after Lloyd (default 3; not with --strict or --no-relax)")
+                  "Iterations per level of 3D shape smoothing after Lloyd (default " + std::to_string(RemeshOptions{}.shape_iterations) + "; not with --strict or --no-relax)")
       ->check(CLI::Range(0, 1000));
   cmd->add_option("--repair-sweeps", args->repair_sweeps,
                   "Sweeps per level of the final repair of the worst triangles (default 6; 0 = off; not with --strict or --no-relax)")
       ->check(CLI::Range(0, 1000));
   cmd->add_option("--repair-threshold", args->repair_threshold,
-                  "Triangles with quality Q below this are repaired (default 0.8)")
+                  "Triangles with quality Q below this are repaired (default " + std::to_string(RemeshOptions{}.repair_threshold).substr(0, 4) + ")")
       ->check(CLI::Range(0.01, 1.0));
   cmd->add_flag("--repair-finest-only", args->repair_finest_only, "Repair only the finest level (default: every level)");
   cmd->add_flag("--repair-no-guard", args->repair_no_guard,
@@ -86,6 +120,13 @@ void add_remesh_command(CLI::App& app) {
     options.repair_error_tolerance = args->repair_tolerance;
     options.rim_min_triangles = args->rim_min_triangles;
     options.curvature_weight = args->curvature;
+    options.curvature_exponent = args->curvature_exponent;
+    options.surface_relax_iterations = args->surface_relax_iterations;
+    options.surface_relax_quality_floor = args->surface_relax_floor;
+    options.smooth_rim = args->smooth_rim;
+    options.base_density_exponent = args->base_density_exponent;
+    options.base_density_smoothing = args->base_density_smoothing;
+    options.snap_tips = args->snap_tips;
     options.relax = args->no_relax ? RelaxMode::none : args->strict ? RelaxMode::new_vertices_only : RelaxMode::all_vertices;
     if (!global_options().quiet) options.progress = terminal_progress();
     const RemeshResult result = remesh(input, options);

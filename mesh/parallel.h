@@ -5,42 +5,61 @@
 #include <algorithm>
 #include <cstddef>
 #include <exception>
+#include <system_error>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace mrsnake {
 
+namespace detail {
+
+/// The loop of parallel_ranges with the thread start passed in, so that a test can make it fail.
+/// A range whose thread cannot be started (std::system_error: no resources) runs on the calling
+/// thread instead, so the loop degrades to fewer threads rather than terminating the program.
+template <class F, class StartThread>
+void parallel_ranges_with(std::size_t n, std::size_t parts, F& f, StartThread&& start_thread) {
+  if (parts <= 1) {
+    if (n > 0) f(std::size_t{0}, n);
+    return;
+  }
+  std::vector<std::exception_ptr> errors(parts);
+  auto run = [&](std::size_t t) {
+    try {
+      f(n * t / parts, n * (t + 1) / parts);
+    } catch (...) {
+      errors[t] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> pool;
+  pool.reserve(parts - 1);
+  std::size_t started = 1;  // range 0 is the calling thread's
+  for (; started < parts; ++started) {
+    try {
+      pool.push_back(start_thread([&run, started] { run(started); }));
+    } catch (const std::system_error&) {
+      break;
+    }
+  }
+  run(0);
+  for (std::size_t t = started; t < parts; ++t) run(t);
+  for (auto& th : pool) th.join();
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+}  // namespace detail
+
 /// Runs f(begin, end) on contiguous ranges of [0, n), one per hardware thread (at most
-/// max_threads), each at least min_per_thread long; rethrows the first exception.
+/// max_threads), each at least min_per_thread long; rethrows the first exception. The range
+/// starting at 0 runs on the calling thread.
 /// \pre f may run concurrently on disjoint ranges.
 template <class F>
 void parallel_ranges(std::size_t n, F&& f, std::size_t min_per_thread = 1024, std::size_t max_threads = 8) {
   const std::size_t hardware = std::max<std::size_t>(1, std::thread::hardware_concurrency());
   const std::size_t parts =
       std::max<std::size_t>(1, std::min({hardware, max_threads, n / std::max<std::size_t>(1, min_per_thread)}));
-  if (parts == 1) {
-    if (n > 0) f(std::size_t{0}, n);
-    return;
-  }
-  std::vector<std::exception_ptr> errors(parts);
-  std::vector<std::thread> pool;
-  pool.reserve(parts - 1);
-  for (std::size_t t = 1; t < parts; ++t)
-    pool.emplace_back([&, t] {
-      try {
-        f(n * t / parts, n * (t + 1) / parts);
-      } catch (...) {
-        errors[t] = std::current_exception();
-      }
-    });
-  try {
-    f(std::size_t{0}, n / parts);
-  } catch (...) {
-    errors[0] = std::current_exception();
-  }
-  for (auto& th : pool) th.join();
-  for (const auto& e : errors)
-    if (e) std::rethrow_exception(e);
+  detail::parallel_ranges_with(n, parts, f, [](auto&& job) { return std::thread(std::move(job)); });
 }
 
 }  // namespace mrsnake

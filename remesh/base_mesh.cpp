@@ -13,15 +13,16 @@ namespace mrsnake {
 namespace {
 
 // Farthest point sampling in 3D over the candidates, continuing from the distances already
-// in `dist` (0 for chosen vertices).
+// in `dist` (0 for chosen vertices). With `density` (wanted point density per vertex) the
+// squared distances are scaled by it: spacing ∝ density^(-1/2).
 void farthest_points(const RowMatrixX3d& X, const std::vector<int>& candidates, int count, std::vector<double>& dist,
-                     std::vector<int>& chosen) {
+                     std::vector<int>& chosen, const Eigen::VectorXd* density = nullptr) {
   for (int k = 0; k < count; ++k) {
     int best = -1;
     double best_d = -1;
     for (int v : candidates)
-      if (dist[v] > best_d) {
-        best_d = dist[v];
+      if (const double d = density ? dist[v] * (*density)[v] : dist[v]; d > best_d) {
+        best_d = d;
         best = v;
       }
     if (best < 0 || best_d <= 0) break;
@@ -126,7 +127,7 @@ int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F, int rim_
   return flips;
 }
 
-BaseMesh build_base_mesh(const Parameterization& param, int n0, int rim_min_triangles) {
+BaseMesh build_base_mesh(const Parameterization& param, int n0, int rim_min_triangles, const Eigen::VectorXd* density) {
   const TriMesh& mesh = param.surface;
   const int n = mesh.num_vertices();
   n0 = std::min(n0, n);
@@ -169,14 +170,14 @@ BaseMesh build_base_mesh(const Parameterization& param, int n0, int rim_min_tria
     std::vector<int> inner;
     for (int v = 0; v < n; ++v)
       if (!boundary[v]) inner.push_back(v);
-    farthest_points(mesh.V, inner, n0 - static_cast<int>(base.samples.size()), dist, base.samples);
+    farthest_points(mesh.V, inner, n0 - static_cast<int>(base.samples.size()), dist, base.samples, density);
   } else {
     int first = 0;
     for (int v = 0; v < n; ++v)
       if ((mesh.V.row(v) - centroid).squaredNorm() > (mesh.V.row(first) - centroid).squaredNorm()) first = v;
     base.samples.push_back(first);
     for (int v = 0; v < n; ++v) dist[v] = (mesh.V.row(v) - mesh.V.row(first)).squaredNorm();
-    farthest_points(mesh.V, all, n0 - 1, dist, base.samples);
+    farthest_points(mesh.V, all, n0 - 1, dist, base.samples, density);
   }
 
   // Triangulates the samples in D, then flips toward regular valences. With a disk, a rim

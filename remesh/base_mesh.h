@@ -21,9 +21,13 @@ struct BaseMesh {
 
 /// With a disk, rim samples left with fewer than rim_min_triangles triangles are dropped and
 /// the rest triangulated again (up to 4 times), so the result may have fewer than n0 vertices.
-/// \pre param comes from parameterize(); n0 >= 6.
+/// With `density` (a wanted point density per vertex of param.surface, > 0) the interior
+/// samples are spaced ∝ density^(-1/2) instead of evenly, so more base vertices (and their
+/// irregular valences) sit where the surface bends.
+/// \pre param comes from parameterize(); n0 >= 6; density, if given, has one entry per vertex.
 /// \throw AlgorithmError if no valid base triangulation results.
-BaseMesh build_base_mesh(const Parameterization& param, int n0, int rim_min_triangles = 3);
+BaseMesh build_base_mesh(const Parameterization& param, int n0, int rim_min_triangles = 3,
+                         const Eigen::VectorXd* density = nullptr);
 
 /// Flips edges (never boundary edges, never making a flipped triangle in D or a duplicate
 /// edge, never leaving an interior vertex with valence < 3 or a boundary vertex with fewer

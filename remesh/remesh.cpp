@@ -12,6 +12,7 @@
 #include "mesh/quality.h"
 #include "remesh/base_mesh.h"
 #include "remesh/domain.h"
+#include "remesh/feature_snap.h"
 #include "remesh/lift.h"
 #include "remesh/lloyd.h"
 #include "remesh/parameterization.h"
@@ -53,6 +54,14 @@ void choose_resolution(int target_faces, int& levels, int& n0) {
   n0 = std::max(8, static_cast<int>(std::lround(f0 / 2 + 2)));
 }
 
+// Moves every row of X to its closest point on the locator's surface.
+void reproject_onto(const SurfaceLocator& surface, RowMatrixX3d& X) {
+  parallel_ranges(static_cast<std::size_t>(X.rows()), [&](std::size_t begin, std::size_t end) {
+    for (auto v = static_cast<Eigen::Index>(begin); v < static_cast<Eigen::Index>(end); ++v)
+      X.row(v) = surface.closest(X.row(v).transpose()).point.transpose();
+  });
+}
+
 }  // namespace
 
 RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
@@ -60,6 +69,15 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   if (options.levels == 0 && options.target_faces < 16) throw std::invalid_argument("target_faces must be at least 16");
   if (options.lloyd_iterations < 0) throw std::invalid_argument("lloyd_iterations must be >= 0");
   if (options.shape_iterations < 0) throw std::invalid_argument("shape_iterations must be >= 0");
+  if (!(options.base_density_exponent >= 0 && options.base_density_exponent <= 4))
+    throw std::invalid_argument("base_density_exponent must be in [0, 4]");
+  if (options.base_density_smoothing < -1) throw std::invalid_argument("base_density_smoothing must be >= -1");
+  if (options.snap_tips < 0) throw std::invalid_argument("snap_tips must be >= 0");
+  if (options.surface_relax_iterations < 0) throw std::invalid_argument("surface_relax_iterations must be >= 0");
+  if (!(options.surface_relax_quality_floor >= 0 && options.surface_relax_quality_floor <= 1))
+    throw std::invalid_argument("surface_relax_quality_floor must be in [0, 1]");
+  if (!(options.curvature_exponent > 0 && options.curvature_exponent <= 4))
+    throw std::invalid_argument("curvature_exponent must be in (0, 4]");
   if (options.repair_sweeps < 0) throw std::invalid_argument("repair_sweeps must be >= 0");
   if (!(options.repair_threshold > 0 && options.repair_threshold <= 1))
     throw std::invalid_argument("repair_threshold must be in (0, 1]");
@@ -106,15 +124,6 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   result.parameterization["seconds"] = seconds_since(simplify_start);  // input checks and simplification included
 
   const auto base_start = Clock::now();
-  report(options.progress, "base mesh", 0);
-  const BaseMesh base = build_base_mesh(param, n0, options.rim_min_triangles);
-  n0 = static_cast<int>(base.domain.rows());
-  result.connectivity = subdivide_connectivity(base.faces, n0, levels);
-  result.parameterization["base_vertices"] = n0;
-  result.parameterization["base_faces"] = base.faces.rows();
-  result.parameterization["base_valence_flips"] = base.valence_flips;
-  result.parameterization["base_dropped_rim_samples"] = base.dropped_rim_samples;
-
   const DomainMesh domain_mesh(param.domain, param.surface.F);
   Eigen::VectorXd wanted = Eigen::VectorXd::Ones(param.surface.num_vertices());  // wanted 3D point density
   if (options.curvature_weight > 0) {
@@ -122,8 +131,27 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     const double mean = kappa.mean();
     // Capped, so that a few sharp spots (voxel steps of a marching-cubes surface) cannot pull
     // the spacing down so fast that triangle shapes suffer.
-    if (mean > 0) wanted.array() += options.curvature_weight * (kappa.array() / mean).min(3.0);
+    if (mean > 0) wanted.array() += options.curvature_weight * (kappa.array() / mean).pow(options.curvature_exponent).min(3.0);
   }
+  report(options.progress, "base mesh", 0);
+  Eigen::VectorXd base_density;
+  if (options.base_density_exponent > 0) {
+    // Averaged over about a base spacing (sqrt(n / n0) edge rings): the base follows where
+    // the surface bends at its own scale, not voxel steps.
+    const int passes = options.base_density_smoothing < 0
+                           ? static_cast<int>(std::lround(std::sqrt(param.surface.num_vertices() / static_cast<double>(n0))))
+                           : options.base_density_smoothing;
+    base_density = smooth_vertex_field(param.surface, wanted, passes).array().pow(options.base_density_exponent).matrix();
+  }
+  const BaseMesh base = build_base_mesh(param, n0, options.rim_min_triangles,
+                                        options.base_density_exponent > 0 ? &base_density : nullptr);
+  n0 = static_cast<int>(base.domain.rows());
+  result.connectivity = subdivide_connectivity(base.faces, n0, levels);
+  result.parameterization["base_vertices"] = n0;
+  result.parameterization["base_faces"] = base.faces.rows();
+  result.parameterization["base_valence_flips"] = base.valence_flips;
+  result.parameterization["base_dropped_rim_samples"] = base.dropped_rim_samples;
+
   DensityField density{&domain_mesh,
                        param.vertex_stretch.cwiseProduct(wanted).array().pow(options.density_exponent).matrix()};
   const DomainKind kind = param.kind;
@@ -159,7 +187,14 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       const int rounds = options.shape_iterations;
       ShapeSmoothingOptions shape;
       shape.iterations = 1;
+      shape.move_rim = options.smooth_rim;
       lloyd.first_movable = 0;
+      ShapeSmoothingOptions surface;
+      surface.iterations = options.surface_relax_iterations;
+      surface.target = SmoothingTarget::area_centroid;
+      surface.surface_density = &wanted;
+      surface.move_rim = options.smooth_rim;
+      surface.quality_floor = options.surface_relax_quality_floor;
       for (int round = 0; round < rounds; ++round) {
         lloyd.iterations = options.lloyd_iterations * (round + 1) / rounds - options.lloyd_iterations * round / rounds;
         const LloydStats s = constrained_lloyd(kind, F, density, U, hints, lloyd);
@@ -170,6 +205,10 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
         level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
         shape_moves += smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, shape);
       }
+      // Sizes last: the area-centroid target evens out what the Lloyd step in D left uneven
+      // where the stretch changes fast; its quality floor keeps the shapes just made.
+      if (surface.iterations > 0)
+        shape_moves += smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, surface);
     } else {
       const bool relax = options.relax == RelaxMode::all_vertices ||
                          (options.relax == RelaxMode::new_vertices_only && j > 0);
@@ -180,21 +219,29 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       }
       level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
     }
+    int snapped = 0;
+    if (options.relax == RelaxMode::all_vertices && options.snap_tips > 0 && j == levels) {
+      FeatureSnapOptions snap;
+      snap.max_snaps = options.snap_tips;
+      snapped = snap_to_input_tips(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, snap);
+    }
+    // Onto the original input before the repair, so that the repair sees (and keeps) the
+    // final triangles: the projection onto a marching-cubes staircase shears a few of them.
+    const bool project_first = reproject && options.repair_after_reprojection;
+    if (project_first) reproject_onto(*reproject, level.positions);
     TriangleRepairStats repair;
     if (options.relax == RelaxMode::all_vertices && options.repair_sweeps > 0 && (options.repair_coarse_levels || j == levels)) {
       TriangleRepairOptions repair_options;
       repair_options.sweeps = options.repair_sweeps;
       repair_options.threshold = options.repair_threshold;
-      repair_options.guard_surface_error = options.repair_guard_finest && j == levels;
+      // Not against a staircase: its voxel steps, not the triangles, make the guard's distances.
+      repair_options.guard_surface_error = options.repair_guard_finest && j == levels && !project_first;
       repair_options.error_tolerance = options.repair_error_tolerance;
+      if (project_first) repair_options.project_onto = reproject.get();
       repair = repair_worst_triangles(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, repair_options);
     }
     report(options.progress, "level " + std::to_string(j), 0.5);
-    if (reproject)
-      parallel_ranges(static_cast<std::size_t>(level.positions.rows()), [&](std::size_t begin, std::size_t end) {
-        for (auto v = static_cast<Eigen::Index>(begin); v < static_cast<Eigen::Index>(end); ++v)
-          level.positions.row(v) = reproject->closest(level.positions.row(v).transpose()).point.transpose();
-      });
+    if (reproject && !project_first) reproject_onto(*reproject, level.positions);
     const int flipped = count_flipped(U, F);
     if (flipped > 0)
       throw AlgorithmError("level " + std::to_string(j) + " has " + std::to_string(flipped) +
@@ -213,6 +260,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     s["lloyd_last_mean_shift"] = relax_stats.mean_shift;
     s["shape_moves"] = shape_moves;
     s["repair_moves"] = repair.moves;
+    s["snapped_vertices"] = snapped;
     if (repair.moves > 0) {
       s["repair_q_min_before"] = repair.q_min_before;
       s["repair_q_min_after"] = repair.q_min_after;
@@ -247,6 +295,14 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["relax"] = relax_name(options.relax);
   j["density_exponent"] = options.density_exponent;
   j["curvature_weight"] = options.curvature_weight;
+  j["curvature_exponent"] = options.curvature_exponent;
+  j["surface_relax_iterations"] = options.relax == RelaxMode::all_vertices ? options.surface_relax_iterations : 0;
+  j["surface_relax_quality_floor"] = options.surface_relax_quality_floor;
+  j["smooth_rim"] = options.smooth_rim;
+  j["base_density_exponent"] = options.base_density_exponent;
+  j["repair_after_reprojection"] = options.repair_after_reprojection;
+  j["snap_tips"] = options.relax == RelaxMode::all_vertices ? options.snap_tips : 0;
+  j["base_density_smoothing"] = options.base_density_smoothing;
   j["lloyd_iterations"] = options.lloyd_iterations;
   j["shape_iterations"] = options.relax == RelaxMode::all_vertices ? options.shape_iterations : 0;
   j["repair_sweeps"] = options.relax == RelaxMode::all_vertices ? options.repair_sweeps : 0;

@@ -41,17 +41,44 @@ struct RemeshOptions {
   /// Curvature sizing: the wanted 3D point density is w = 1 + curvature_weight·κ/mean(κ)
   /// (remesh/sizing.h) and the Lloyd density (stretch·w)^density_exponent. 0 = even 3D spacing.
   double curvature_weight = 1.0;
+  /// Curvature sizing exponent p: w = 1 + curvature_weight·min((κ/mean κ)^p, 3). The chord
+  /// error of a triangle of size h is ~κh², so spacing ∝ κ^(-1/3) (p = 2/3) minimizes the mean
+  /// squared distance for a given vertex count.
+  double curvature_exponent = 1.0;
+  /// Base vertices are spread by farthest-point sampling with squared distances scaled by
+  /// w^base_density_exponent (w: the curvature sizing's wanted density): more base vertices,
+  /// and so more irregular ones, where the surface bends, which they absorb. 0 = even in 3D.
+  /// 1: RMS -20 % on the bear (now below CGAL's at 16k faces), -7 % on blobby 16k.
+  double base_density_exponent = 1.0;
+  /// Passes of 1-ring averaging of that density first; -1 = about one base spacing,
+  /// round(sqrt(input vertices / n0)). 3: without it the liver's base followed voxel steps
+  /// (Hausdorff 1.25 % at 16k faces); with 6 or more the bear lost its gain.
+  int base_density_smoothing = 3;
   /// Lloyd iterations per level (level 0 included unless relax == new_vertices_only).
   int lloyd_iterations = 8;
   /// With all_vertices: iterations per level of tangential smoothing toward equilateral 3D
   /// triangles, moved in D (remesh/shape_smoothing.h). The Lloyd step evens out sizes but is
   /// affine invariant, so it cannot repair shear; this can. 0 = the Lloyd step alone.
-  int shape_iterations = 3;
+  /// 6 (was 3): Q mean +0.01 on every bench input at ~+2 % RMS (docs/bench-remesh.md).
+  int shape_iterations = 6;
+  /// With all_vertices: iterations per level of tangential relaxation on the surface after the
+  /// Lloyd and shape rounds (remesh/shape_smoothing.h, SmoothingTarget::area_centroid): each vertex
+  /// moves toward the density x area weighted mean of its 3D triangles' centroids, so sizes even
+  /// out where the parameterization's stretch changes too fast for the Lloyd step in D. 0 = off.
+  /// 3: RMS -3 to -10 % on bear, heart and mushroom for Q mean -0.005 to -0.01.
+  int surface_relax_iterations = 3;
+  /// The surface relaxation refuses a move that lowers the smallest Q of the vertex's triangles
+  /// below min(before, this): without it the min angle fell below 30° on the liver (32k faces).
+  double surface_relax_quality_floor = 0.75;
+  /// Disk inputs: rim vertices slide along the rim during shape smoothing and surface relaxation
+  /// (toward the midpoint of their rim neighbours in 3D), staying on the circle in D.
+  bool smooth_rim = true;
   /// With all_vertices: sweeps per level of the final repair of the worst triangles
   /// (remesh/triangle_repair.h): vertices of triangles with Q < repair_threshold move
   /// tangentially, on the input, only when that raises the smallest Q around them. 0 = off.
   int repair_sweeps = 6;
-  double repair_threshold = 0.8;
+  /// 0.85 (was 0.8): Q mean +0.005 to +0.01; 0.9 pushed the heart's Hausdorff past 0.5 %.
+  double repair_threshold = 0.85;
   /// Repair every level (true) or only the finest (false; coarse levels keep the Lloyd layout).
   bool repair_coarse_levels = true;
   /// On the finest level, refuse repair moves that take triangles further from the surface
@@ -60,6 +87,14 @@ struct RemeshOptions {
   bool repair_guard_finest = true;
   /// The guard lets triangles move away from the surface by up to this x the mean edge length.
   double repair_error_tolerance = 0.03;
+  /// With all_vertices, on the finest level: up to this many vertices snap onto the input's
+  /// vertices farthest from the level (its tips, which the Lloyd steps cut off), before the
+  /// repair (remesh/feature_snap.h). 0 = off.
+  int snap_tips = 32;
+  /// With a simplified input: project each level onto the original input before the repair
+  /// (which then moves vertices on the original) instead of after it, so the repair sees the
+  /// triangles the projection shears (on the liver's staircase it cost Q min 0.59).
+  bool repair_after_reprojection = true;
   /// Disk inputs: a base rim vertex with fewer triangles than this is dropped from the base
   /// mesh (remesh/base_mesh.h); with 2 its corners stay obtuse at every level. 1 = keep all.
   int rim_min_triangles = 3;

@@ -1,57 +1,135 @@
 #include "remesh/shape_smoothing.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <optional>
+#include <unordered_set>
 
 #include <Eigen/Dense>
 
+#include "mesh/quality.h"
 #include "remesh/surface_moves.h"
 
 namespace mrsnake {
+namespace {
+
+// For each disk rim vertex, its two rim neighbours (previous and next along the boundary);
+// -1 elsewhere.
+std::vector<Eigen::Vector2i> rim_neighbours(const RowMatrixX3i& F, int n) {
+  auto key = [](int a, int b) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
+  };
+  std::unordered_set<std::uint64_t> directed;
+  directed.reserve(3 * F.rows());
+  for (int f = 0; f < F.rows(); ++f)
+    for (int e = 0; e < 3; ++e) directed.insert(key(F(f, e), F(f, (e + 1) % 3)));
+  std::vector<Eigen::Vector2i> rim(n, Eigen::Vector2i(-1, -1));
+  for (int f = 0; f < F.rows(); ++f)
+    for (int e = 0; e < 3; ++e) {
+      const int a = F(f, e), b = F(f, (e + 1) % 3);
+      if (directed.count(key(b, a))) continue;
+      rim[a][1] = b;  // a -> b runs along the boundary
+      rim[b][0] = a;
+    }
+  return rim;
+}
+
+}  // namespace
 
 int smooth_shapes_in_domain(DomainKind kind, const RowMatrixX3i& F, const DomainMesh& param,
                             const RowMatrixX3d& surface_V, RowMatrixX3d& U, RowMatrixX3d& X,
                             std::vector<int>& hints, const ShapeSmoothingOptions& options) {
   const int n = static_cast<int>(U.rows());
   const std::vector<bool> boundary = kind == DomainKind::disk ? boundary_vertices(F, n) : std::vector<bool>(n, false);
+  const std::vector<Eigen::Vector2i> rim = kind == DomainKind::disk && options.move_rim
+                                               ? rim_neighbours(F, n)
+                                               : std::vector<Eigen::Vector2i>();
   const VertexStars stars(F, n);
   const auto& PF = param.faces();
   const auto& PD = param.positions();
+  const bool weighted = options.target == SmoothingTarget::area_centroid && options.surface_density != nullptr;
+  // Wanted density under vertex v (its hint face holds it).
+  auto density_at = [&](int v) {
+    const DomainMesh::Location loc = param.locate(U.row(v).transpose(), hints[v]);
+    const Eigen::VectorXd& w = *options.surface_density;
+    return loc.barycentric[0] * w[PF(loc.face, 0)] + loc.barycentric[1] * w[PF(loc.face, 1)] +
+           loc.barycentric[2] * w[PF(loc.face, 2)];
+  };
+  Eigen::VectorXd vertex_density = Eigen::VectorXd::Ones(n);
+  // Smallest Q of v's triangles with v at x in 3D.
+  auto star_quality = [&](int v, const Eigen::Vector3d& x) {
+    double q = 1;
+    for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
+      const int f = stars.faces[i];
+      Eigen::Vector3d P[3] = {X.row(F(f, 0)), X.row(F(f, 1)), X.row(F(f, 2))};
+      for (int k = 0; k < 3; ++k)
+        if (F(f, k) == v) P[k] = x;
+      q = std::min(q, frey_borouchaki_quality(P[0], P[1], P[2]));
+    }
+    return q;
+  };
   int moves = 0;
   for (int it = 0; it < options.iterations; ++it) {
+    if (weighted)
+      for (int v = 0; v < n; ++v) vertex_density[v] = density_at(v);
     for (int v = options.first_movable; v < n; ++v) {
-      if (boundary[v]) continue;
+      const bool on_rim = boundary[v];
+      if (on_rim && !options.move_rim) continue;
       const Eigen::Vector3d x = X.row(v);
-      const std::optional<Eigen::Vector3d> normal = vertex_normal(X, F, stars, v);
-      if (!normal) continue;
-      Eigen::Vector3d target = Eigen::Vector3d::Zero();
-      int count = 0;
-      for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
-        const int f = stars.faces[i];
-        int k = 0;
-        while (F(f, k) != v) ++k;
-        if (const auto apex = equilateral_apex(X.row(F(f, (k + 1) % 3)), X.row(F(f, (k + 2) % 3)), *normal)) {
-          target += *apex;
-          ++count;
+      Eigen::Vector3d move = Eigen::Vector3d::Zero();
+      if (on_rim) {
+        const int prev = rim[v][0], next = rim[v][1];
+        if (prev < 0 || next < 0) continue;
+        const Eigen::Vector3d a = X.row(prev), b = X.row(next);
+        if (!((b - a).norm() > 0)) continue;
+        const Eigen::Vector3d tangent = (b - a).normalized();
+        move = (0.5 * (a + b) - x).dot(tangent) * tangent;
+      } else {
+        const std::optional<Eigen::Vector3d> normal = vertex_normal(X, F, stars, v);
+        if (!normal) continue;
+        Eigen::Vector3d target = Eigen::Vector3d::Zero();
+        double total = 0;
+        for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
+          const int f = stars.faces[i];
+          int k = 0;
+          while (F(f, k) != v) ++k;
+          const int ia = F(f, (k + 1) % 3), ib = F(f, (k + 2) % 3);
+          const Eigen::Vector3d a = X.row(ia), b = X.row(ib);
+          if (options.target == SmoothingTarget::equilateral_apexes) {
+            if (const auto apex = equilateral_apex(a, b, *normal)) {
+              target += *apex;
+              total += 1;
+            }
+          } else {
+            const double rho = (vertex_density[v] + vertex_density[ia] + vertex_density[ib]) / 3.0;
+            const double weight = 0.5 * (a - x).cross(b - x).norm() * rho * rho;
+            target += weight * (x + a + b) / 3.0;
+            total += weight;
+          }
         }
+        if (!(total > 0)) continue;
+        move = target / total - x;
+        move -= move.dot(*normal) * *normal;
       }
-      if (count == 0) continue;
-      Eigen::Vector3d move = target / count - x;
-      move -= move.dot(*normal) * *normal;
       // Pull the 3D move back to D through the affine map of the input triangle under v.
       const std::optional<TrianglePullback> pullback = TrianglePullback::of(surface_V, PD, PF, hints[v]);
       if (!pullback) continue;
       const Eigen::Vector3d domain_move = pullback->to_domain(move);
       const Eigen::Vector3d current = U.row(v);
+      const double floor = options.quality_floor > 0 ? std::min(star_quality(v, x), options.quality_floor) : 0.0;
       double t = options.step;
       for (int attempt = 0; attempt < 8; ++attempt, t *= 0.5) {
-        const Eigen::Vector3d candidate = project_to_domain(kind, current + t * domain_move, false);
+        const Eigen::Vector3d candidate = project_to_domain(kind, current + t * domain_move, on_rim);
         if (!star_unflipped_in_domain(U, F, stars, v, candidate)) continue;
         const DomainMesh::Location loc = param.locate(candidate, hints[v]);
+        const Eigen::Vector3d lifted = loc.barycentric[0] * surface_V.row(PF(loc.face, 0)).transpose() +
+                                       loc.barycentric[1] * surface_V.row(PF(loc.face, 1)).transpose() +
+                                       loc.barycentric[2] * surface_V.row(PF(loc.face, 2)).transpose();
+        if (options.quality_floor > 0 && star_quality(v, lifted) < floor) continue;
         hints[v] = loc.face;
         U.row(v) = candidate.transpose();
-        X.row(v) = loc.barycentric[0] * surface_V.row(PF(loc.face, 0)) + loc.barycentric[1] * surface_V.row(PF(loc.face, 1)) +
-                   loc.barycentric[2] * surface_V.row(PF(loc.face, 2));
+        X.row(v) = lifted.transpose();
         ++moves;
         break;
       }

@@ -26,20 +26,24 @@ Eigen::VectorXd vertex_curvature(const TriMesh& mesh, int smoothing) {
       count[u] += 1;
       count[v] += 1;
     }
-  Eigen::VectorXd kappa = sum.cwiseQuotient(count.cwiseMax(1.0));
-  for (int pass = 0; pass < smoothing; ++pass) {
-    Eigen::VectorXd next = kappa, weight = Eigen::VectorXd::Ones(n);
+  return smooth_vertex_field(mesh, sum.cwiseQuotient(count.cwiseMax(1.0)), smoothing);
+}
+
+Eigen::VectorXd smooth_vertex_field(const TriMesh& mesh, Eigen::VectorXd field, int passes) {
+  const int n = mesh.num_vertices();
+  for (int pass = 0; pass < passes; ++pass) {
+    Eigen::VectorXd next = field, weight = Eigen::VectorXd::Ones(n);
     for (int f = 0; f < mesh.num_faces(); ++f)
       for (int k = 0; k < 3; ++k) {
         const int u = mesh.F(f, k), v = mesh.F(f, (k + 1) % 3);
-        next[u] += kappa[v];
-        next[v] += kappa[u];
+        next[u] += field[v];
+        next[v] += field[u];
         weight[u] += 1;
         weight[v] += 1;
       }
-    kappa = next.cwiseQuotient(weight);
+    field = next.cwiseQuotient(weight);
   }
-  return kappa;
+  return field;
 }
 
 }  // namespace mrsnake

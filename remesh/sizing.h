@@ -13,4 +13,9 @@ namespace mrsnake {
 /// \pre mesh is a manifold triangle mesh without unreferenced vertices.
 Eigen::VectorXd vertex_curvature(const TriMesh& mesh, int smoothing = 3);
 
+/// `field` (one value per vertex) averaged `passes` times over each vertex's 1-ring (itself
+/// included, each neighbour once per incident edge side).
+/// \pre field has one entry per vertex of mesh; passes >= 0.
+Eigen::VectorXd smooth_vertex_field(const TriMesh& mesh, Eigen::VectorXd field, int passes);
+
 }  // namespace mrsnake

@@ -63,9 +63,10 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
   auto lift = [&](const Eigen::Vector3d& u, int& hint) {
     const DomainMesh::Location loc = param.locate(u, hint);
     hint = loc.face;
-    return Eigen::Vector3d(loc.barycentric[0] * surface_V.row(PF(loc.face, 0)).transpose() +
-                           loc.barycentric[1] * surface_V.row(PF(loc.face, 1)).transpose() +
-                           loc.barycentric[2] * surface_V.row(PF(loc.face, 2)).transpose());
+    const Eigen::Vector3d lifted = loc.barycentric[0] * surface_V.row(PF(loc.face, 0)).transpose() +
+                                   loc.barycentric[1] * surface_V.row(PF(loc.face, 1)).transpose() +
+                                   loc.barycentric[2] * surface_V.row(PF(loc.face, 2)).transpose();
+    return options.project_onto ? Eigen::Vector3d(options.project_onto->closest(lifted).point) : lifted;
   };
   // How far v's triangles (v at u in D, x in 3D) leave the surface: the largest distance
   // between an edge's 3D midpoint and the lift of its midpoint in D, and (with `old` = v's

@@ -14,6 +14,7 @@
 /// would flip a triangle in D is never taken. Disk rim vertices slide along the circle.
 #include <vector>
 
+#include "mesh/distance.h"
 #include "mesh/trimesh.h"
 #include "remesh/domain.h"
 
@@ -29,6 +30,10 @@ struct TriangleRepairOptions {
   /// to its new triangles): better shapes must not cut across ridges or tips.
   bool guard_surface_error = false;
   double error_tolerance = 0.03;
+  /// If set, every lifted position is then moved to its closest point on this surface (the
+  /// original input when the parameterized surface is a simplification of it): the repair
+  /// then judges and keeps the triangles as they will finally be. X must already be on it.
+  const SurfaceLocator* project_onto = nullptr;
 };
 
 struct TriangleRepairStats {
@@ -38,7 +43,8 @@ struct TriangleRepairStats {
 };
 
 /// Repairs the worst triangles of (X, F) by moving vertices tangentially; updates U, X and hints.
-/// \pre X = lift of U onto the surface whose domain mesh is `param` (3D positions surface_V);
+/// \pre X = lift of U onto the surface whose domain mesh is `param` (3D positions surface_V),
+///      then projected onto options.project_onto if set;
 ///      no triangle of (U, F) flipped in D; hints has one face of `param` per vertex.
 /// \post no triangle of (U, F) is flipped in D; the smallest Q of every moved vertex's
 ///       triangles went up, so the mesh's smallest Q never goes down; with

@@ -59,6 +59,11 @@ class TimeGuard : public itk::Command {
   double max_seconds = 5.0;
   int iterations = 0;
   bool timed_out = false;
+  double min_relative_change = 0;
+  int window = 5;
+  std::vector<double> level_values;  ///< the metric at each iteration of the current level
+  int converged_levels = 0;          ///< levels stopped by the metric-change test
+  bool level_converged = false;      ///< the current level was
   void Execute(itk::Object* caller, const itk::EventObject& event) override { Execute(static_cast<const itk::Object*>(caller), event); }
   void Execute(const itk::Object*, const itk::EventObject& event) override {
     if (!itk::IterationEvent().CheckEvent(&event)) return;
@@ -66,6 +71,19 @@ class TimeGuard : public itk::Command {
     if (std::chrono::duration<double>(Clock::now() - start).count() > max_seconds) {
       timed_out = true;
       optimizer->StopOptimization();
+      return;
+    }
+    if (min_relative_change > 0 && window > 0) {
+      level_values.push_back(optimizer->GetValue());
+      const int n = static_cast<int>(level_values.size());
+      if (n > window) {
+        const auto [lo, hi] = std::minmax_element(level_values.end() - (window + 1), level_values.end());
+        if (*hi - *lo < min_relative_change * std::abs(level_values.back())) {
+          ++converged_levels;
+          level_converged = true;
+          optimizer->StopOptimization();
+        }
+      }
     }
   }
 };
@@ -265,7 +283,7 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
     for (int a = 0; a < 3; ++a) start[a] = o.initial_translation[a];
     transform->SetTranslation(start);
 
-    const auto eval_points = grid_points(fixed, 16000);
+    const auto eval_points = grid_points(fixed, std::max(64, o.evaluation_samples));
     // ITK's own filters inside the registration (smoothing, shrinking, the metric's helpers)
     // take the global default thread count: o.threads for the span of the registration, so
     // that it runs on one thread and repeats bit for bit.
@@ -331,6 +349,8 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
     guard->optimizer = optimizer;
     guard->start = t0;
     guard->max_seconds = o.max_seconds;
+    guard->min_relative_change = o.min_relative_change;
+    guard->window = o.convergence_window;
     optimizer->AddObserver(itk::IterationEvent(), guard);
     // Iterations per level: the optimizer restarts its count at each level.
     struct LevelCounter : public itk::Command {
@@ -345,6 +365,8 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
       void Execute(const itk::Object*, const itk::EventObject&) override {
         if (!per_level->empty()) per_level->back() = guard->iterations - at_start;
         at_start = guard->iterations;
+        guard->level_values.clear();
+        guard->level_converged = false;
         // Each finer level starts from the coarser one's result: shorter first steps.
         optimizer->SetLearningRate(first_step * std::pow(step_factor, static_cast<double>(per_level->size())));
         per_level->push_back(0);
@@ -359,7 +381,10 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
     registration->AddObserver(itk::MultiResolutionIterationEvent(), counter);
     registration->Update();
     if (!result.iterations.empty()) result.iterations.back() = guard->iterations - counter->at_start;
-    result.stop_condition = guard->timed_out ? "time budget spent" : optimizer->GetStopConditionDescription();
+    result.stop_condition = guard->timed_out         ? "time budget spent"
+                            : guard->level_converged ? "metric change below min_relative_change"
+                                                     : optimizer->GetStopConditionDescription();
+    result.converged_levels = guard->converged_levels;
 
     result.optimization_seconds = std::chrono::duration<double>(Clock::now() - t_opt).count();
     const Transform* final_transform = registration->GetTransformOutput()->Get();

@@ -145,7 +145,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   report(progress, "normalize", 0.0);
   // The full-resolution image is not copied: its sampler normalizes on the fly, and only
   // the (8× smaller and below) pyramid levels are stored normalized.
-  result.window = robust_intensity_window(image);
+  result.window = robust_intensity_window(image, 1.0, 99.0, std::max<std::size_t>(1024, options.intensity_samples));
   const double norm_scale = 1.0 / (result.window.high - result.window.low);
   const double norm_offset = -result.window.low * norm_scale;
   end_stage("normalize");
@@ -360,7 +360,8 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     out.snake = finer_than_image ? skipped : snake.run(V, search, step, range);
     out.deformed = !finer_than_image;
     // The fold test inside the run is local; a surface can still pass through itself.
-    if (options.undo_self_intersections)
+    // (A level only synthesized has not moved from its start: nothing to undo.)
+    if (options.undo_self_intersections && out.deformed)
       out.rolled_back_vertices = undo_self_intersections(V, V_level_start, model.faces(j), snake.rings()).moved_vertices;
     out.seconds = seconds_since(t_level);
     out.surface = TriMesh{V, model.faces(j)};
@@ -418,6 +419,7 @@ nlohmann::json segment_report(const SegmentResult& r) {
       reg["valid_points"] = {x.valid_points_initial, x.valid_points_final};
       reg["iterations_per_level"] = x.iterations;
       reg["stop_condition"] = x.stop_condition;
+      reg["levels_stopped_on_metric_change"] = x.converged_levels;
       reg["moving_crop_size"] = x.moving_crop_size;
       reg["edge_radius_mm"] = x.edge_radius_mm;
       reg["cpu_seconds"] = x.cpu_seconds;

@@ -87,6 +87,10 @@ struct SegmentOptions {
   double edge_per_voxel = 2.0;    ///< pyramid level choice (appearance.h)
   double max_edge_cost = 0.35;    ///< step-edge matches worse than this are ignored (forces.h)
   double max_profile_cost = 0.4;  ///< profile matches with a correlation below 0.6 are ignored
+  /// Voxels (on a regular stride) from which the robust intensity window is estimated: a
+  /// quarter of the default 2^20 takes a few ms instead of ~15 ms at 128³ and 256³ and moves
+  /// the 1st and 99th percentiles by well under 1% of the window (tests/snake).
+  std::size_t intensity_samples = std::size_t{1} << 18;
   bool count_self_intersections = true;
   /// After each level, move the vertices of self-intersecting faces back towards the
   /// level's start (deformable_surface.h).

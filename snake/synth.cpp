@@ -2,17 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <exception>
 #include <functional>
 #include <limits>
 #include <random>
 #include <sstream>
-#include <thread>
 
 #include <nlohmann/json.hpp>
 
 #include "mesh/errors.h"
 #include "mesh/marching_cubes.h"
+#include "mesh/parallel.h"
 #include "snake/image_filters_itk.h"
 
 namespace mrsnake {
@@ -302,30 +301,9 @@ void degrade(Volume& image, const SynthParams& p, double contrast, const Progres
   }
 }
 
-/// Runs f(begin, end, is_first) on contiguous ranges of [0, n), one per hardware thread,
-/// and rethrows the first exception.
-void parallel_ranges(std::size_t n, const std::function<void(std::size_t, std::size_t, bool)>& f) {
-  const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 8);
-  const std::size_t parts = std::max<std::size_t>(1, std::min(threads, n / 4));
-  if (parts == 1) return f(0, n, true);
-  std::vector<std::exception_ptr> errors(parts);
-  std::vector<std::thread> pool;
-  for (std::size_t t = 0; t < parts; ++t)
-    pool.emplace_back([&, t] {
-      try {
-        f(n * t / parts, n * (t + 1) / parts, t == 0);
-      } catch (...) {
-        errors[t] = std::current_exception();
-      }
-    });
-  for (auto& th : pool) th.join();
-  for (const auto& e : errors)
-    if (e) std::rethrow_exception(e);
-}
-
 /// Moves each vertex onto the zero level of f by Newton steps along the gradient.
 void project_onto_surface(RowMatrixX3d& V, const std::function<double(const Eigen::Vector3d&)>& f, double h, double max_step) {
-  parallel_ranges(static_cast<std::size_t>(V.rows()), [&](std::size_t begin, std::size_t end, bool) {
+  parallel_ranges(static_cast<std::size_t>(V.rows()), [&](std::size_t begin, std::size_t end) {
     for (int v = static_cast<int>(begin); v < static_cast<int>(end); ++v) {
       Eigen::Vector3d x = V.row(v).transpose();
       for (int it = 0; it < 10; ++it) {
@@ -345,7 +323,7 @@ void project_onto_surface(RowMatrixX3d& V, const std::function<double(const Eige
       }
       V.row(v) = x.transpose();
     }
-  });
+  }, 4);
 }
 
 }  // namespace
@@ -585,7 +563,8 @@ SynthResult render_synth(const SynthParams& params, const ProgressFn& progress) 
       if (heart) std::swap(out_lo, out_hi);
     }
   };
-  parallel_ranges(nz, [&](std::size_t k0, std::size_t k1, bool first) { render_slab(k0, k1, first); });
+  // The slab starting at 0 runs on the calling thread: it reports the progress.
+  parallel_ranges(nz, [&](std::size_t k0, std::size_t k1) { render_slab(k0, k1, k0 == 0); }, 4);
   report(progress, "synth: shape", 1.0);
 
   degrade(r.image, params, o.foreground - o.background, progress);

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <system_error>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -128,6 +131,22 @@ TEST(ParallelRanges, CoversEveryIndexOnceAndRethrows) {
                  if (end == 100000) throw std::runtime_error("the last range's worker");
                }, 16),
                std::runtime_error);
+}
+
+TEST(ParallelRanges, ARangeWhoseThreadCannotStartRunsOnTheCaller) {
+  const std::size_t n = 1000, parts = 4;
+  std::vector<std::atomic<int>> hits(n);
+  auto count = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) ++hits[i];
+  };
+  int starts = 0;
+  // The first worker starts, every later one fails as std::thread does without resources.
+  detail::parallel_ranges_with(n, parts, count, [&](auto&& job) {
+    if (++starts > 1) throw std::system_error(std::make_error_code(std::errc::resource_unavailable_try_again));
+    return std::thread(std::move(job));
+  });
+  EXPECT_EQ(starts, 2);
+  for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(hits[i].load(), 1) << "index " << i;
 }
 
 TEST(SurfaceDistance, MeshAgainstItselfIsZero) {

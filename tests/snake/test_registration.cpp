@@ -152,6 +152,35 @@ TEST(Registration, PlacesTheSurfaceOfABlobWithinAVoxel) {
   EXPECT_LT(e.scale, 0.02);
 }
 
+TEST(Registration, StopsALevelWhenTheMetricStopsChanging) {
+  // The metric-change stop: with a threshold no change can pass (0), no level stops on it;
+  // with one every change passes (a 100% change), each level stops as soon as its window
+  // is full, i.e. after window + 1 iterations, and says so.
+  const PosedPair pair = posed_pair(SynthShape::ellipsoid, 48, 8.0);
+  const Volume crop = reference_crop(pair.reference.image, pair.reference.truth_mesh.V);
+  Volume normalized = pair.target.image;
+  normalize_intensities(normalized);
+  RegistrationOptions o;
+  o.max_seconds = 1e9;
+  o.iterations_per_level = 25;
+  o.min_relative_change = 0;
+  const RegistrationResult full = register_similarity(crop, normalized, o);
+  EXPECT_EQ(full.converged_levels, 0);
+  ASSERT_EQ(full.iterations.size(), o.shrink_factors.size());
+  o.min_relative_change = 1.0;
+  o.convergence_window = 3;
+  const RegistrationResult early = register_similarity(crop, normalized, o);
+  EXPECT_EQ(early.converged_levels, static_cast<int>(o.shrink_factors.size()));
+  ASSERT_EQ(early.iterations.size(), o.shrink_factors.size());
+  for (std::size_t l = 0; l < early.iterations.size(); ++l) {
+    EXPECT_EQ(early.iterations[l], o.convergence_window + 1) << "level " << l;
+    EXPECT_GT(full.iterations[l], early.iterations[l]) << "level " << l;
+  }
+  EXPECT_NE(early.stop_condition.find("metric change"), std::string::npos) << early.stop_condition;
+  // Still an improvement on the start (the best parameters seen are returned).
+  EXPECT_LT(early.final_metric, early.initial_metric);
+}
+
 TEST(Registration, StartsFromAGivenTranslation) {
   // The target's frame moved 60 mm away: from the identity there is no overlap; from the
   // right start translation the pose is found again (the retry of segment's registration

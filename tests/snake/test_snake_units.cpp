@@ -128,6 +128,29 @@ TEST(Pyramid, NormalizationMapsPercentiles) {
   EXPECT_THROW(normalize_intensities(flat), InputError);
 }
 
+TEST(Pyramid, TheSegmentsIntensitySubsampleGivesTheFullImagesWindow) {
+  // A noisy sphere on a dark background (2^20 voxels): the window segment estimates from
+  // SegmentOptions::intensity_samples voxels on a regular stride is the one of every voxel,
+  // to within 1% of its width.
+  Volume v = make_grid({128, 128, 64}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
+  std::mt19937 rng(11);
+  std::normal_distribution<float> noise(0.0f, 0.25f);
+  for (std::size_t k = 0; k < 64; ++k)
+    for (std::size_t j = 0; j < 128; ++j)
+      for (std::size_t i = 0; i < 128; ++i) {
+        const double r2 = (i - 64.0) * (i - 64.0) + (j - 64.0) * (j - 64.0) + 4.0 * (k - 32.0) * (k - 32.0);
+        v.at(i, j, k) = (r2 < 40.0 * 40.0 ? 1.0f : 0.0f) + noise(rng);
+      }
+  const IntensityWindow all = robust_intensity_window(v, 1.0, 99.0, v.data.size());
+  const SegmentOptions options;
+  ASSERT_LT(options.intensity_samples, v.data.size() / 3);  // a true subsample
+  const IntensityWindow sub = robust_intensity_window(v, 1.0, 99.0, options.intensity_samples);
+  const double width = all.high - all.low;
+  EXPECT_GT(width, 1.0);
+  EXPECT_NEAR(sub.low, all.low, 0.01 * width);
+  EXPECT_NEAR(sub.high, all.high, 0.01 * width);
+}
+
 TEST(Rasterize, SphereMatchesTheLatticeWithObliqueDirection) {
   const Eigen::Matrix3d D = rotation(35, {1, -1, 2});
   const Volume grid = make_grid({40, 36, 30}, {0.8, 0.9, 1.1}, {-12, -14, -11}, D);

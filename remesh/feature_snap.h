@@ -1,0 +1,32 @@
+#pragma once
+/// \file feature_snap.h
+/// Snapping level vertices onto the input's tips. Lloyd steps pull every vertex toward the
+/// centroid of its cell, so no vertex stays on a sharp tip of the input and the level cuts it
+/// off: the Hausdorff distance is then that tip's height. This step finds the input vertices
+/// farthest from the level (worst first) and moves the nearest level vertex onto each, in D
+/// (exact lift: the vertex is the input vertex), when that flips nothing in D and leaves the
+/// vertex's triangles with Q >= min_quality and angles >= min_angle_deg.
+#include <vector>
+
+#include "mesh/trimesh.h"
+#include "remesh/domain.h"
+
+namespace mrsnake {
+
+struct FeatureSnapOptions {
+  int max_snaps = 32;            ///< at most this many vertices move
+  double min_distance = 0.1;     ///< only input vertices farther than this x the mean edge length
+  double min_quality = 0.65;     ///< the moved vertex's triangles keep Q >= this
+  double min_angle_deg = 32;     ///< and angles >= this (the repair after it cannot move a snapped tip)
+};
+
+/// Snaps vertices of (U, F) (lifted X) onto the input vertices farthest from (X, F).
+/// \pre X = lift of U onto the surface whose domain mesh is `param` (3D positions surface_V);
+///      no triangle of (U, F) flipped in D; hints has one face of `param` per vertex.
+/// \post no triangle flipped in D; every moved vertex is exactly an input vertex (U and X);
+///       disk rim vertices do not move.
+/// \return the number of vertices moved.
+int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh& param, const RowMatrixX3d& surface_V,
+                       RowMatrixX3d& U, RowMatrixX3d& X, std::vector<int>& hints, const FeatureSnapOptions& options);
+
+}  // namespace mrsnake
