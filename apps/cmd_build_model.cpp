@@ -4,12 +4,15 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <future>
+#include <memory>
 #include <optional>
 #include <iostream>
 
 #include "apps/cli.h"
 #include "apps/report/remesh_page.h"
 #include "mesh/atomic_file.h"
+#include "mesh/distance.h"
 #include "mesh/image_io.h"
 #include "mesh/marching_cubes.h"
 #include "mesh/quality.h"
@@ -105,6 +108,10 @@ void add_build_model_command(CLI::App& app) {
            " surface; closed its tunnels with a radius of " + std::to_string(surface.closing_radius) + " voxels");
     lap("marching_cubes");
 
+    // The report page measures every level against the input: its tree is built on the
+    // other core while the (single-threaded) parameterization solve runs.
+    std::future<std::unique_ptr<SurfaceLocator>> input_locator = std::async(
+        std::launch::async, [&surface] { return std::make_unique<SurfaceLocator>(surface.mesh); });
     RemeshOptions ro;
     ro.levels = a->levels;
     ro.target_faces = a->faces;
@@ -168,6 +175,8 @@ void add_build_model_command(CLI::App& app) {
     mrsnake::reports::RemeshPageOptions page;
     page.title = "mrsnake build-model " + std::filesystem::path(a->output).filename().string();
     page.input = &surface.mesh;
+    const std::unique_ptr<SurfaceLocator> locator = input_locator.get();
+    page.input_locator = locator.get();
     page.unrelaxed = unrelaxed ? &*unrelaxed : nullptr;
     page.report = quality;
     page.report["input"] = a->labels + " (label " + std::to_string(a->label) + ")";

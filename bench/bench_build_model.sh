@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # End-to-end benchmark of `mrsnake build-model` on the liver labels (label 255): seconds per
-# stage (from the command's own timings), wall time and peak memory of the whole process, the
+# stage (from the command's own timings), wall time, CPU time (user + system: less sensitive
+# to other jobs on a shared machine than the wall time) and peak memory of the whole process, the
 # face counts, and the model's fidelity: RMS and Hausdorff distance of its finest level to the
 # full-resolution marching-cubes surfaces (`mrsnake mc`, the voxels' own surface, and
 # `mrsnake mc --smooth 20`; 442,712 faces each) in % of their bounding-box diagonal, with its
@@ -14,7 +15,7 @@ labels="$data/volumes/liver-labels.nii.gz"
 [ -f "$labels" ] || { echo "skipped: $labels not found (set MRSNAKE_DATA)"; exit 0; }
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
-/usr/bin/time -f '%e %M' -o "$out/time" "$bin" -q build-model --labels "$labels" --label 255 -o "$out/liver.model" --json "$@" > "$out/summary.json"
+/usr/bin/time -f '%e %M %U %S' -o "$out/time" "$bin" -q build-model --labels "$labels" --label 255 -o "$out/liver.model" --json "$@" > "$out/summary.json"
 "$bin" -q mc --labels "$labels" --label 255 -o "$out/voxels.vtp" > /dev/null
 "$bin" -q mc --labels "$labels" --label 255 --smooth 20 -o "$out/smoothed.vtp" > /dev/null
 levels="$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['levels'])" "$out/summary.json")"
@@ -23,7 +24,7 @@ levels="$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['level
 python3 - "$out/summary.json" "$out/time" "$out/quality.json" "$out/quality20.json" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))
-wall, kb = open(sys.argv[2]).read().split()
+wall, kb, user, system = open(sys.argv[2]).read().split()
 q = json.load(open(sys.argv[3]))
 d, d20 = q["distance"], json.load(open(sys.argv[4]))["distance"]
 print(f"build-model liver-labels.nii.gz label 255: {s['faces']} faces, {s['levels']} levels, "
@@ -33,6 +34,7 @@ for t in s['timings']:
     print(f"{t['stage']:<20}{t['seconds']:>10.3f}")
 print(f"{'total (in process)':<20}{s['total_seconds']:>10.3f}")
 print(f"{'wall (process)':<20}{float(wall):>10.3f}")
+print(f"{'CPU user+sys (s)':<20}{float(user) + float(system):>10.3f}")
 print(f"{'peak memory (MB)':<20}{int(kb)/1024:>10.0f}")
 print("finest level against the full-resolution marching-cubes surface:")
 print(f"{'':<20}{'mrsnake mc':>22}{'mc --smooth 20':>22}")

@@ -81,6 +81,23 @@ RowMatrixX3d sample_surface(const TriMesh& mesh, int per_face, std::mt19937_64& 
   return P;
 }
 
+/// A uniform random subset of `cap` rows of P (partial Fisher-Yates; rows kept in order), or
+/// P itself when it has no more than cap rows or cap <= 0.
+RowMatrixX3d subsample_rows(RowMatrixX3d P, long long cap, std::mt19937_64& rng) {
+  const auto n = static_cast<long long>(P.rows());
+  if (cap <= 0 || n <= cap) return P;
+  std::vector<Eigen::Index> index(static_cast<std::size_t>(n));
+  for (long long i = 0; i < n; ++i) index[i] = static_cast<Eigen::Index>(i);
+  for (long long i = 0; i < cap; ++i) {
+    const long long j = i + static_cast<long long>(rng() % static_cast<unsigned long long>(n - i));
+    std::swap(index[i], index[j]);
+  }
+  std::sort(index.begin(), index.begin() + cap);
+  RowMatrixX3d out(cap, 3);
+  for (long long i = 0; i < cap; ++i) out.row(i) = P.row(index[i]);
+  return out;
+}
+
 }  // namespace
 
 struct SurfaceLocator::Impl {
@@ -139,8 +156,19 @@ SurfaceDistance surface_distance(const TriMesh& mesh, const TriMesh& reference, 
   if (mesh.empty() || reference.empty())
     throw InputError("a surface distance needs two meshes with at least one face each");
   std::mt19937_64 rng(options.seed);
-  const RowMatrixX3d on_mesh = sample_surface(mesh, options.samples_per_face, rng);
-  const RowMatrixX3d on_reference = sample_surface(reference, options.samples_per_face, rng);
+  RowMatrixX3d on_mesh = sample_surface(mesh, options.samples_per_face, rng);
+  RowMatrixX3d on_reference = sample_surface(reference, options.samples_per_face, rng);
+  if (options.max_samples_per_mesh > 0) {
+    // One fraction for both sets, so that each direction keeps its weight in the pooled figures.
+    const double larger = static_cast<double>(std::max(on_mesh.rows(), on_reference.rows()));
+    const double keep = std::min(1.0, static_cast<double>(options.max_samples_per_mesh) / larger);
+    const auto thin = [&](RowMatrixX3d P) {
+      const auto cap = std::max<long long>(1, std::llround(keep * static_cast<double>(P.rows())));
+      return subsample_rows(std::move(P), cap, rng);
+    };
+    on_mesh = thin(std::move(on_mesh));
+    on_reference = thin(std::move(on_reference));
+  }
   const Eigen::VectorXd forward = reference_locator.distances(on_mesh);
   const Eigen::VectorXd backward = SurfaceLocator(mesh).distances(on_reference);
 

@@ -40,6 +40,12 @@ class SurfaceLocator {
 struct DistanceOptions {
   int samples_per_face = 10;  ///< random points per face, on top of every vertex
   unsigned seed = 1;          ///< for reproducible sampling
+  /// > 0: at most this many points (vertices and face samples) of the mesh with more are
+  /// measured, a uniform random subset, and the other mesh's points are thinned by the same
+  /// fraction (same seed, same subsets): each direction keeps its weight, so the pooled RMS
+  /// and mean stay unbiased; the Hausdorff distance is the largest over the subsets (a lower
+  /// bound). 0 = all of them.
+  long long max_samples_per_mesh = 0;
 };
 
 /// Symmetric surface distance: every vertex plus samples_per_face random points per face

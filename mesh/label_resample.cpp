@@ -1,21 +1,64 @@
-// ITK translation unit: no Eigen and no CGAL here (ITK bundles its own Eigen).
+// The label's smoothed occupancy on an isotropic grid: a separable FIR Gaussian and a
+// trilinear resampling written out (plain C++: this replaced ITK's recursive Gaussian and
+// ResampleImageFilter, 2.5x faster on the liver for the same surface, see
+// docs/bench-build-model.md).
 #include "mesh/label_resample.h"
 
-#include <itkIdentityTransform.h>
-#include <itkLinearInterpolateImageFunction.h>
-#include <itkResampleImageFilter.h>
-#include <itkSmoothingRecursiveGaussianImageFilter.h>
-
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "mesh/errors.h"
-#include "mesh/itk_volume.h"
+#include "mesh/parallel.h"
 
 namespace mrsnake {
+
+namespace {
+
+/// A sampled, normalized Gaussian of standard deviation sigma_voxels, truncated at 3 sigma
+/// (at least one tap each side).
+std::vector<float> gaussian_taps(double sigma_voxels) {
+  const int radius = std::max(1, static_cast<int>(std::ceil(3.0 * sigma_voxels)));
+  std::vector<float> taps(2 * radius + 1);
+  double sum = 0;
+  for (int t = -radius; t <= radius; ++t) sum += std::exp(-0.5 * t * t / (sigma_voxels * sigma_voxels));
+  for (int t = -radius; t <= radius; ++t)
+    taps[t + radius] = static_cast<float>(std::exp(-0.5 * t * t / (sigma_voxels * sigma_voxels)) / sum);
+  return taps;
+}
+
+/// Convolves the volume in place along axis d with the taps (zero beyond its ends: the crop's
+/// margin is zero), line by line on the hardware threads.
+void convolve_axis(Volume& v, int d, const std::vector<float>& taps) {
+  const long radius = static_cast<long>(taps.size() / 2);
+  const long n = static_cast<long>(v.size[d]);
+  const std::size_t stride = d == 0 ? 1 : d == 1 ? v.size[0] : v.size[0] * v.size[1];
+  // Lines along d: indexed by the other two coordinates.
+  const int a = d == 0 ? 1 : 0, b = d == 2 ? 1 : 2;
+  const std::size_t lines = v.size[a] * v.size[b];
+  parallel_ranges(lines, [&](std::size_t begin, std::size_t end) {
+    std::vector<float> line(static_cast<std::size_t>(n));
+    for (std::size_t l = begin; l < end; ++l) {
+      std::size_t c[3] = {0, 0, 0};
+      c[a] = l % v.size[a];
+      c[b] = l / v.size[a];
+      float* p = v.data.data() + v.index(c[0], c[1], c[2]);
+      for (long i = 0; i < n; ++i) line[i] = p[i * stride];
+      for (long i = 0; i < n; ++i) {
+        float sum = 0;
+        const long lo = std::max(0L, i - radius), hi = std::min(n - 1, i + radius);
+        for (long t = lo; t <= hi; ++t) sum += taps[t - i + radius] * line[t];
+        p[i * stride] = sum;
+      }
+    }
+  }, 64);
+}
+
+}  // namespace
 
 Volume label_occupancy(const Volume& labels, int label, const OccupancyOptions& options) {
   if (!(options.spacing_mm > 0)) throw std::invalid_argument("the occupancy grid spacing must be positive");
@@ -75,48 +118,46 @@ Volume label_occupancy(const Volume& labels, int label, const OccupancyOptions& 
       for (long i = lo[0]; i <= hi[0]; ++i)
         if (labels.at(i, j, k) == target) crop.at(i - start[0], j - start[1], k - start[2]) = 1.0f;
 
-  using Image = itk_volume::FloatImage;
-  try {
-    const Image::Pointer mask = itk_volume::to_itk(crop);
-    auto smooth = itk::SmoothingRecursiveGaussianImageFilter<Image, Image>::New();
-    smooth->SetInput(mask);
-    smooth->SetSigma(sigma);
-
-    // The output grid: isotropic, the input's direction, covering the crop.
-    Volume out;
-    out.direction = labels.direction;
-    out.origin = crop.origin;
-    out.spacing = {options.spacing_mm, options.spacing_mm, options.spacing_mm};
-    Image::SizeType size;
-    Image::SpacingType spacing;
-    Image::PointType origin;
-    Image::DirectionType direction;
-    for (int d = 0; d < 3; ++d) {
-      const double extent = (static_cast<double>(crop.size[d]) - 1) * crop.spacing[d];
-      out.size[d] = static_cast<std::size_t>(std::floor(extent / options.spacing_mm)) + 1;
-      size[d] = out.size[d];
-      spacing[d] = options.spacing_mm;
-      origin[d] = out.origin[d];
-      for (int c = 0; c < 3; ++c) direction(d, c) = labels.direction[3 * d + c];
+  // Separable Gaussian of the mask, then trilinear samples on the output grid (same origin
+  // and direction as the crop, so each axis maps on its own).
+  for (int d = 0; d < 3; ++d) convolve_axis(crop, d, gaussian_taps(sigma / crop.spacing[d]));
+  Volume out;
+  out.direction = labels.direction;
+  out.origin = crop.origin;
+  out.spacing = {options.spacing_mm, options.spacing_mm, options.spacing_mm};
+  for (int d = 0; d < 3; ++d)
+    out.size[d] = static_cast<std::size_t>(
+                      std::floor((static_cast<double>(crop.size[d]) - 1) * crop.spacing[d] / options.spacing_mm)) +
+                  1;
+  out.data.assign(out.num_voxels(), 0.0f);
+  // Per axis: the crop index below each output sample and the weight of the one above.
+  std::array<std::vector<std::size_t>, 3> i0;
+  std::array<std::vector<float>, 3> w1;
+  for (int d = 0; d < 3; ++d) {
+    for (std::size_t i = 0; i < out.size[d]; ++i) {
+      const double x = static_cast<double>(i) * options.spacing_mm / crop.spacing[d];
+      std::size_t lo = std::min(static_cast<std::size_t>(std::floor(x)), crop.size[d] - 1);
+      if (lo + 1 > crop.size[d] - 1 && lo > 0) lo = crop.size[d] - 2;
+      i0[d].push_back(lo);
+      w1[d].push_back(static_cast<float>(std::clamp(x - static_cast<double>(lo), 0.0, 1.0)));
     }
-    auto resample = itk::ResampleImageFilter<Image, Image>::New();
-    resample->SetInput(smooth->GetOutput());
-    resample->SetTransform(itk::IdentityTransform<double, 3>::New());
-    resample->SetInterpolator(itk::LinearInterpolateImageFunction<Image, double>::New());
-    resample->SetSize(size);
-    resample->SetOutputSpacing(spacing);
-    resample->SetOutputOrigin(origin);
-    resample->SetOutputDirection(direction);
-    resample->SetDefaultPixelValue(0.0f);
-    resample->Update();
-    const float* r = resample->GetOutput()->GetBufferPointer();
-    out.data.assign(r, r + out.num_voxels());
-    for (float& v : out.data) v = std::clamp(v, 0.0f, 1.0f);
-    return out;
-  } catch (const itk::ExceptionObject& e) {
-    throw AlgorithmError(std::string("smoothing and resampling the label failed (") + e.GetDescription() +
-                         "); try another --mc-spacing, or 0 for the voxels' own surface");
   }
+  parallel_ranges(out.size[2], [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k)
+      for (std::size_t j = 0; j < out.size[1]; ++j)
+        for (std::size_t i = 0; i < out.size[0]; ++i) {
+          const std::size_t x = i0[0][i], y = i0[1][j], z = i0[2][k];
+          const float fx = w1[0][i], fy = w1[1][j], fz = w1[2][k];
+          const auto c = [&](std::size_t dx, std::size_t dy, std::size_t dz) {
+            return crop.at(x + dx, y + dy, z + dz);
+          };
+          const float c00 = c(0, 0, 0) + fx * (c(1, 0, 0) - c(0, 0, 0)), c10 = c(0, 1, 0) + fx * (c(1, 1, 0) - c(0, 1, 0));
+          const float c01 = c(0, 0, 1) + fx * (c(1, 0, 1) - c(0, 0, 1)), c11 = c(0, 1, 1) + fx * (c(1, 1, 1) - c(0, 1, 1));
+          const float c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
+          out.at(i, j, k) = std::clamp(c0 + fz * (c1 - c0), 0.0f, 1.0f);
+        }
+  }, 1);
+  return out;
 }
 
 }  // namespace mrsnake

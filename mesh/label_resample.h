@@ -1,9 +1,9 @@
 #pragma once
 /// \file label_resample.h
-/// A smooth occupancy field of one label on a coarser isotropic grid (ITK; plain Volume
-/// interface), for marching cubes at the 0.5 level: the Gaussian removes the voxel staircase
-/// and anti-aliases the resampling, and the coarser grid gives a surface of a size that a
-/// model needs (tens of thousands of faces instead of hundreds of thousands).
+/// A smooth occupancy field of one label on a coarser isotropic grid, for marching cubes at
+/// the 0.5 level: the Gaussian removes the voxel staircase and anti-aliases the resampling,
+/// and the coarser grid gives a surface of a size that a model needs (tens of thousands of
+/// faces instead of hundreds of thousands).
 #include "mesh/volume.h"
 
 namespace mrsnake {
@@ -20,13 +20,13 @@ struct OccupancyOptions {
   double sigma_mm = 0;
 };
 
-/// The label's mask (1 inside, 0 outside), Gaussian-smoothed and linearly resampled to an
+/// The label's mask (1 inside, 0 outside), Gaussian-smoothed (a sampled, normalized kernel
+/// truncated at 3 sigma, separable, on the image's voxels) and linearly resampled to an
 /// isotropic grid with the input's direction, cropped to the label's bounding box plus a
 /// margin of zeros (so the 0.5 isosurface closes). Values lie in [0, 1].
 /// \pre options.spacing_mm > 0
 /// \throw InputError if no voxel has the label, or if the crop or the output grid would hold
 ///        more than kMaxOccupancyGridVoxels voxels (a spacing far from the image's).
-/// \throw AlgorithmError if ITK fails (e.g. out of memory).
 /// \throw std::invalid_argument if options.spacing_mm is not positive.
 Volume label_occupancy(const Volume& labels, int label, const OccupancyOptions& options = {});
 

@@ -57,12 +57,15 @@ TopologyReport topology_report(const TriMesh& mesh) {
   const double diag = bounding_box_diagonal(mesh.V);
   const double area_eps = 1e-14 * diag * diag;
 
-  // Directed half-edges and undirected edges as sorted keys (runs = counts): sorting is
-  // several times faster than hashing on meshes of hundreds of thousands of faces.
-  std::vector<std::uint64_t> directed, undirected;
-  directed.reserve(3 * static_cast<std::size_t>(m));
-  undirected.reserve(3 * static_cast<std::size_t>(m));
+  // Half-edges as sorted keys of their undirected edge (runs = counts), shifted left by one
+  // with the direction in the lowest bit (1 = from the larger index): sorting is several
+  // times faster than hashing on meshes of hundreds of thousands of faces, and an edge's two
+  // half-edges are consistently oriented exactly when their bits differ. (Indices are
+  // non-negative ints, so the key's top bit is free for the shift.)
+  // The keys are bucketed by their smaller vertex (a counting sort) and each bucket, a
+  // vertex's few edges, is sorted on its own: the same order as one sort of the whole array.
   std::vector<char> used(n, 0);
+  std::vector<int> bucket(static_cast<std::size_t>(n) + 1, 0);
   UnionFind faces_uf(n);
   for (int f = 0; f < m; ++f) {
     const int a = mesh.F(f, 0), b = mesh.F(f, 1), c = mesh.F(f, 2);
@@ -72,17 +75,33 @@ TopologyReport topology_report(const TriMesh& mesh) {
       const Eigen::Vector3d e1 = mesh.V.row(b) - mesh.V.row(a), e2 = mesh.V.row(c) - mesh.V.row(a);
       if (0.5 * e1.cross(e2).norm() <= area_eps) ++r.degenerate_faces;
     }
+    faces_uf.unite(a, b);  // joins a, b and c: the same components as uniting every edge
+    faces_uf.unite(b, c);
     for (int k = 0; k < 3; ++k) {
       const int u = mesh.F(f, k), v = mesh.F(f, (k + 1) % 3);
       used[u] = 1;
-      if (u == v) continue;
-      directed.push_back(key(u, v));
-      undirected.push_back(key(std::min(u, v), std::max(u, v)));
-      faces_uf.unite(u, v);
+      if (u != v) ++bucket[std::min(u, v) + 1];
     }
   }
-  std::sort(directed.begin(), directed.end());
-  std::sort(undirected.begin(), undirected.end());
+  for (int v = 0; v < n; ++v) bucket[v + 1] += bucket[v];
+  std::vector<std::uint64_t> undirected(static_cast<std::size_t>(bucket[n]));
+  {
+    std::vector<int> next(bucket.begin(), bucket.end() - 1);
+    for (int f = 0; f < m; ++f)
+      for (int k = 0; k < 3; ++k) {
+        const int u = mesh.F(f, k), v = mesh.F(f, (k + 1) % 3);
+        if (u != v) undirected[next[std::min(u, v)]++] = key(std::min(u, v), std::max(u, v)) << 1 | (u > v ? 1u : 0u);
+      }
+  }
+  for (int v = 0; v < n; ++v) {
+    const auto first = undirected.begin() + bucket[v], last = undirected.begin() + bucket[v + 1];
+    if (last - first <= 32) {
+      for (auto i = first; i != last; ++i)  // insertion sort: a handful of keys
+        for (auto j = i; j != first && *(j - 1) > *j; --j) std::iter_swap(j - 1, j);
+    } else {
+      std::sort(first, last);
+    }
+  }
   r.referenced_vertices = static_cast<int>(std::count(used.begin(), used.end(), 1));
 
   // Boundary edges and loops: boundary vertices are joined by boundary edges; a loop is a
@@ -91,9 +110,9 @@ TopologyReport topology_report(const TriMesh& mesh) {
   std::vector<char> on_boundary(n, 0);
   for (std::size_t i = 0; i < undirected.size();) {
     std::size_t j = i + 1;
-    while (j < undirected.size() && undirected[j] == undirected[i]) ++j;
+    while (j < undirected.size() && undirected[j] >> 1 == undirected[i] >> 1) ++j;
     const std::size_t count = j - i;
-    const std::uint64_t k = undirected[i];
+    const std::uint64_t k = undirected[i] >> 1;
     const int u = static_cast<int>(k >> 32), v = static_cast<int>(k & 0xffffffffu);
     ++r.edges;
     if (count == 1) {
@@ -102,9 +121,8 @@ TopologyReport topology_report(const TriMesh& mesh) {
       on_boundary[u] = on_boundary[v] = 1;
     } else if (count > 2) {
       ++r.non_manifold_edges;
-    } else {
-      const auto range = std::equal_range(directed.begin(), directed.end(), key(u, v));
-      if (range.second - range.first != 1) ++r.inconsistently_oriented_edges;
+    } else if (undirected[i] == undirected[i + 1]) {  // both half-edges run the same way
+      ++r.inconsistently_oriented_edges;
     }
     i = j;
   }
@@ -120,8 +138,39 @@ TopologyReport topology_report(const TriMesh& mesh) {
   const std::vector<int>& offset = stars.offset;
   const std::vector<int>& incident = stars.faces;
   std::vector<int> link, parent;
+  // Most stars are small: their link vertices go into fixed arrays searched linearly (no
+  // allocation, no sort); larger stars use the sorted vectors.
+  constexpr int kSmallStar = 16;
   for (int v = 0; v < n; ++v) {
-    if (offset[v + 1] - offset[v] < 2) continue;
+    const int star = offset[v + 1] - offset[v];
+    if (star < 2) continue;
+    if (star <= kSmallStar) {
+      int ids[2 * kSmallStar], up[2 * kSmallStar], count = 0;
+      const auto id = [&](int w) {
+        for (int i = 0; i < count; ++i)
+          if (ids[i] == w) return i;
+        ids[count] = w;
+        up[count] = count;
+        return count++;
+      };
+      const auto root = [&](int x) {
+        while (up[x] != x) x = up[x] = up[up[x]];
+        return x;
+      };
+      for (int i = offset[v]; i < offset[v + 1]; ++i) {
+        int others[2], c = 0;
+        for (int k = 0; k < 3 && c < 2; ++k)
+          if (mesh.F(incident[i], k) != v) others[c++] = mesh.F(incident[i], k);
+        if (c < 2) continue;
+        const int a = id(others[0]), b = id(others[1]);
+        up[root(a)] = root(b);
+      }
+      int fans = 0;
+      for (int x = 0; x < count; ++x)
+        if (root(x) == x) ++fans;
+      if (fans > 1) ++r.non_manifold_vertices;
+      continue;
+    }
     link.clear();
     for (int i = offset[v]; i < offset[v + 1]; ++i) {
       int others[2], c = 0;

@@ -12,6 +12,7 @@
 #include <Eigen/SparseLU>
 
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include "mesh/errors.h"
@@ -21,18 +22,41 @@ namespace mrsnake {
 namespace {
 
 using EigenMatrix = CGAL::Eigen_sparse_matrix<double>::EigenType;
-using LUTraits = CGAL::Eigen_solver_traits<Eigen::SparseLU<EigenMatrix, Eigen::COLAMDOrdering<int>>>;
+// Only the types (Matrix, Vector, NT) of these traits are used: the solve is ours.
+using BaseTraits = CGAL::Eigen_solver_traits<Eigen::SparseLU<EigenMatrix, Eigen::COLAMDOrdering<int>>>;
+using NaturalLU = Eigen::SparseLU<EigenMatrix, Eigen::NaturalOrdering<int>>;
 
-// CGAL solves the same matrix for u and for v: factor it once.
-struct CachedLUTraits : LUTraits {
+// CGAL solves the same matrix for u and for v: factor it once. The rows and columns are
+// permuted symmetrically by AMD on the pattern of A + Aᵀ (a mesh Laplacian's pattern is
+// symmetric), keeping the dominant diagonal in place, then factored without reordering and
+// with threshold pivoting (the diagonal stays the pivot while it is at least 0.1 of its
+// column's largest entry; partial pivoting's row swaps cost fill): about 2-3x as fast as
+// SparseLU's COLAMD column ordering on a 90k-vertex liver. (A symmetric ordering given to
+// SparseLU as a column ordering alone moves the diagonal off the pivots and fills in
+// catastrophically.)
+struct CachedLUTraits : BaseTraits {
   const Matrix* factored = nullptr;
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P;  // permuted = P A Pᵀ
+  std::shared_ptr<NaturalLU> lu = std::make_shared<NaturalLU>();     // traits are copied by CGAL
   bool linear_solver(const Matrix& A, const Vector& B, Vector& X, NT& D) {
     if (factored != &A) {
-      if (!LUTraits::factor(A, D)) return false;
+      const EigenMatrix& M = A.eigen_object();
+      Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> Pinv;
+      Eigen::AMDOrdering<int> amd;
+      amd(M, Pinv);
+      P = Pinv.inverse();
+      const EigenMatrix permuted = P * M * P.transpose();
+      lu->setPivotThreshold(0.1);
+      lu->compute(permuted);
+      if (lu->info() != Eigen::Success) return false;
       factored = &A;
     }
     D = 1;
-    return LUTraits::linear_solver(B, X);
+    // A x = b  <=>  (P A Pᵀ)(P x) = P b.
+    const Eigen::VectorXd y = lu->solve(P * Eigen::VectorXd(B));
+    if (lu->info() != Eigen::Success) return false;
+    X = P.transpose() * y;
+    return true;
   }
 };
 

@@ -27,6 +27,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+/// Points measured per surface for the per-level distance statistics.
+constexpr long long kMaxStatsSamples = 50000;
+
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 const char* relax_name(RelaxMode mode) {
@@ -265,15 +268,19 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     if (options.compute_stats) {
       const TriMesh mesh{level.positions, F};
       s["quality"] = mesh_quality(mesh);
-      // Metro-style sampling of both surfaces, capped at ~500k samples per surface: a
-      // marching-cubes input has hundreds of thousands of faces.
+      // Metro-style sampling of both surfaces, then a uniform random subset of at most 50k
+      // points per surface: a marching-cubes input has hundreds of thousands of faces, and
+      // 50k points estimate the RMS to well under 1 % (the Hausdorff distance is the largest
+      // over the subset).
       DistanceOptions sampling;
       sampling.samples_per_face =
           std::clamp(static_cast<int>(5e5 / std::max(original.num_faces(), mesh.num_faces())), 1, 10);
+      sampling.max_samples_per_mesh = kMaxStatsSamples;
       // The input's tree is built once for every level (the reprojection's when there is one).
       if (!reproject && !input_locator) input_locator = std::make_unique<SurfaceLocator>(original);
       s["distance"] = surface_distance(mesh, original, reproject ? *reproject : *input_locator, sampling);
       s["distance"]["samples_per_face"] = sampling.samples_per_face;
+      s["distance"]["max_samples_per_mesh"] = sampling.max_samples_per_mesh;
     }
     result.levels.push_back(std::move(level));
     report(options.progress, "level " + std::to_string(j), 1.0);

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mesh/distance.h"
 #include "mesh/trimesh.h"
 #include "remesh/remesh.h"
 
@@ -20,6 +21,9 @@ struct RemeshPageOptions {
   /// The input surface: quality and distance of levels whose stats lack them are computed
   /// against it (build-model computes no stats by default). Null: such cells stay empty.
   const TriMesh* input = nullptr;
+  /// A closest-point locator already built on `input` (e.g. while the parameterization ran),
+  /// or null: the page builds one when it needs it.
+  const SurfaceLocator* input_locator = nullptr;
   /// Random samples per face of both meshes for those distances; 0 = automatic: 10 (as
   /// remesh's own stats), fewer for a large input so that it gets about 100,000 samples, and
   /// none beyond the vertices for an input of more than 100,000 faces (whose vertices are

@@ -109,6 +109,29 @@ TEST(RemeshPage, WithoutRendersTheNotesReplaceThePictures) {
   EXPECT_EQ(count(html, "The geometric error needs the input surface"), 0);
 }
 
+TEST(RemeshPage, AGivenInputLocatorIsUsedForTheDistances) {
+  const Remeshed& r = remeshed();
+  RemeshOptions o;
+  o.levels = 2;
+  o.base_vertices = 24;
+  o.compute_stats = false;  // the page measures the distances itself
+  const RemeshResult result = remesh(r.input, o);
+  reports::RemeshPageOptions options;
+  options.renders = false;
+  options.input = &r.input;
+  const std::string own = reports::remesh_report_html(result, options);
+  EXPECT_EQ(count(own, "–</td>"), 0) << "a distance cell is empty";
+  const SurfaceLocator locator(r.input);
+  options.input_locator = &locator;
+  EXPECT_EQ(reports::remesh_report_html(result, options), own);
+  // A locator on another surface changes the distances: the page really queries it.
+  TriMesh larger = r.input;
+  larger.V *= 1.5;
+  const SurfaceLocator other(larger);
+  options.input_locator = &other;
+  EXPECT_NE(reports::remesh_report_html(result, options), own);
+}
+
 TEST(RemeshPage, StretchIsTheAreaRatio) {
   // One level whose 3D positions are its domain positions scaled by 3: stretch 9 on every face.
   RemeshResult r;

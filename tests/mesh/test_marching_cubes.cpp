@@ -172,6 +172,56 @@ TEST(MarchingCubes, OccupancyIsInZeroOneAndClosesAtTheBorder) {
   EXPECT_THROW(label_occupancy(labels, 2, o), InputError);
 }
 
+TEST(MarchingCubes, OccupancyIsTheMaskSmoothedBySigmaAndCrossesOneHalfAtTheVoxelBoundary) {
+  // A box of voxels of 0.6 x 0.6 x 1.3 mm (the liver's shape of voxel), origin 0, identity
+  // direction, sampled on a 1.3 mm grid: along z the samples are the voxel centres. There the
+  // field is the mask convolved with the sampled Gaussian of sigma = 1.3/3 mm (taps at 0 and
+  // ±1.3 mm: weights 1 and exp(-4.5), normalized), so the last voxel inside has exactly
+  // 1 - w and the first outside w; the 0.5 crossing is halfway between them, on the voxels'
+  // boundary. Along x (samples every 1.3 mm over 0.6 mm voxels) the crossing is within the
+  // linear interpolation's error of the boundary.
+  Volume labels = grid(40, {0.6, 0.6, 1.3});
+  labels.data.assign(labels.num_voxels(), 0.0f);
+  for (std::size_t k = 10; k <= 25; ++k)
+    for (std::size_t j = 8; j <= 30; ++j)
+      for (std::size_t i = 12; i <= 27; ++i) labels.at(i, j, k) = 3.0f;
+  OccupancyOptions o;
+  o.spacing_mm = 1.3;
+  const Volume field = label_occupancy(labels, 3, o);
+  ASSERT_EQ(field.spacing[2], 1.3);
+  const double w = std::exp(-4.5) / (1 + 2 * std::exp(-4.5));
+  // The sample nearest the box's middle, and the 0.5 crossings along axis d through it (mm).
+  std::size_t middle[3];
+  const double middle_mm[3] = {0.6 * 19.5, 0.6 * 19, 1.3 * 17.5};
+  for (int e = 0; e < 3; ++e) middle[e] = static_cast<std::size_t>(std::lround((middle_mm[e] - field.origin[e]) / 1.3));
+  const auto value = [&](int d, std::size_t i) {
+    std::size_t p[3] = {middle[0], middle[1], middle[2]};
+    p[d] = i;
+    return static_cast<double>(field.at(p[0], p[1], p[2]));
+  };
+  const auto crossings = [&](int d) {
+    std::vector<double> found;
+    for (std::size_t i = 0; i + 1 < field.size[d]; ++i) {
+      const double a = value(d, i), b = value(d, i + 1);
+      if ((a - 0.5) * (b - 0.5) < 0) found.push_back(field.origin[d] + 1.3 * (static_cast<double>(i) + (0.5 - a) / (b - a)));
+    }
+    return found;
+  };
+  const std::vector<double> x = crossings(0), z = crossings(2);
+  ASSERT_EQ(z.size(), 2u);
+  EXPECT_NEAR(z[0], 1.3 * 9.5, 1e-4);
+  EXPECT_NEAR(z[1], 1.3 * 25.5, 1e-4);
+  const auto z_index = [&](double k) { return static_cast<std::size_t>(std::lround((1.3 * k - field.origin[2]) / 1.3)); };
+  EXPECT_NEAR(value(2, z_index(10)), 1 - w, 1e-5);
+  EXPECT_NEAR(value(2, z_index(9)), w, 1e-5);
+  EXPECT_NEAR(value(2, z_index(17)), 1.0, 1e-5);
+  ASSERT_EQ(x.size(), 2u);
+  EXPECT_NEAR(x[0], 0.6 * 11.5, 0.3);
+  EXPECT_NEAR(x[1], 0.6 * 27.5, 0.3);
+  EXPECT_NEAR(x[0] + x[1], 0.6 * 39, 0.6);
+  EXPECT_LT(field.at(0, 0, 0), 1e-6f);
+}
+
 TEST(MarchingCubes, KeepsTheLargestComponentAndReportsTheOthers) {
   std::size_t count = 0;
   Volume labels = voxelized_ball(grid(40, {1, 1, 1}), {12, 12, 12}, 8.0, 1, count);

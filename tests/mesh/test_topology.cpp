@@ -57,6 +57,30 @@ TEST(Topology, TwoComponentsAndDefects) {
   EXPECT_FALSE(r.is_manifold());
 }
 
+TEST(Topology, FlippedFacesMakeInconsistentlyOrientedEdges) {
+  TriMesh m = icosphere(4);  // 5120 faces, 7680 edges
+  EXPECT_EQ(topology_report(m).inconsistently_oriented_edges, 0);
+  m.F.col(1).swap(m.F.col(2));  // every face flipped: consistent again
+  EXPECT_EQ(topology_report(m).inconsistently_oriented_edges, 0);
+  // One face flipped: its 3 edges; two neighbours flipped: 4 (their shared edge agrees again).
+  TriMesh one = icosahedron();
+  std::swap(one.F(0, 1), one.F(0, 2));
+  const auto r = topology_report(one);
+  EXPECT_EQ(r.inconsistently_oriented_edges, 3);
+  EXPECT_EQ(r.edges, 30);
+  EXPECT_EQ(r.non_manifold_edges, 0);
+  int neighbour = -1;
+  for (int f = 1; f < one.num_faces() && neighbour < 0; ++f) {
+    int shared = 0;
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) shared += one.F(0, i) == one.F(f, k);
+    if (shared == 2) neighbour = f;
+  }
+  ASSERT_GE(neighbour, 0);
+  std::swap(one.F(neighbour, 1), one.F(neighbour, 2));
+  EXPECT_EQ(topology_report(one).inconsistently_oriented_edges, 4);
+}
+
 TEST(Topology, BowtieVertexIsNonManifold) {
   TriMesh m;
   m.V.resize(5, 3);

@@ -1,0 +1,111 @@
+// The mean value parameterization's sparse solve (remesh/cgal_mean_value.cpp): whatever the
+// ordering and factorization, the disk map must solve Floater's mean value system.
+#include <gtest/gtest.h>
+
+#include <Eigen/SparseLU>
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+#include <vector>
+
+#include "mesh/topology.h"
+#include "remesh/parameterization.h"
+#include "tests/remesh/remesh_shapes.h"
+
+using namespace mrsnake;
+
+namespace {
+
+// Mean value weights: w_ij = (tan(a/2) + tan(b/2)) / |x_i - x_j|, a and b the angles at x_i of
+// the two triangles beside edge ij (Floater 2003), assembled face by face.
+Eigen::SparseMatrix<double> mean_value_weights(const TriMesh& m) {
+  std::vector<Eigen::Triplet<double>> w;
+  for (int f = 0; f < m.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int i = m.F(f, k), j = m.F(f, (k + 1) % 3), l = m.F(f, (k + 2) % 3);
+      const Eigen::Vector3d a = m.V.row(j) - m.V.row(i), b = m.V.row(l) - m.V.row(i);
+      const double t = std::tan(0.5 * std::atan2(a.cross(b).norm(), a.dot(b)));
+      w.emplace_back(i, j, t / a.norm());
+      w.emplace_back(i, l, t / b.norm());
+    }
+  Eigen::SparseMatrix<double> W(m.num_vertices(), m.num_vertices());
+  W.setFromTriplets(w.begin(), w.end());
+  return W;
+}
+
+}  // namespace
+
+TEST(MeanValueMap, SolvesTheMeanValueSystemAsAPlainSparseLUDoesWithoutFlips) {
+  const TriMesh disk = test::spherical_cap(5);
+  const int n = disk.num_vertices();
+  ASSERT_GT(n, 5000);
+  ASSERT_TRUE(topology_report(disk).is_disk());
+  const Eigen::MatrixX2d uv = mean_value_disk_map(disk);
+  ASSERT_EQ(uv.rows(), n);
+
+  const std::vector<bool> boundary = [&] {
+    std::vector<bool> b(n, false);
+    // A boundary edge is used by one face only.
+    std::vector<std::pair<int, int>> edges;
+    for (int f = 0; f < disk.num_faces(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        const int u = disk.F(f, k), v = disk.F(f, (k + 1) % 3);
+        edges.emplace_back(std::min(u, v), std::max(u, v));
+      }
+    std::sort(edges.begin(), edges.end());
+    for (std::size_t i = 0; i < edges.size(); ++i) {
+      const bool single = (i == 0 || edges[i - 1] != edges[i]) && (i + 1 == edges.size() || edges[i + 1] != edges[i]);
+      if (single) b[edges[i].first] = b[edges[i].second] = true;
+    }
+    return b;
+  }();
+  int rim = 0;
+  for (int v = 0; v < n; ++v)
+    if (boundary[v]) {
+      ++rim;
+      EXPECT_NEAR((uv.row(v) - Eigen::RowVector2d(0.5, 0.5)).norm(), 0.5, 1e-12) << v;  // on CGAL's unit-diameter circle
+    }
+  ASSERT_GT(rim, 50);
+
+  // Interior rows: sum_j w_ij (u_j - u_i) = 0; boundary rows: u_i fixed at the map's value.
+  const Eigen::SparseMatrix<double> W = mean_value_weights(disk);
+  std::vector<Eigen::Triplet<double>> a;
+  Eigen::MatrixX2d rhs = Eigen::MatrixX2d::Zero(n, 2);
+  for (int i = 0; i < n; ++i)
+    if (boundary[i]) {
+      a.emplace_back(i, i, 1.0);
+      rhs.row(i) = uv.row(i);
+    }
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> Wr = W;
+  double worst_residual = 0;
+  for (int i = 0; i < n; ++i) {
+    if (boundary[i]) continue;
+    double sum = 0;
+    Eigen::RowVector2d r = Eigen::RowVector2d::Zero();
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Wr, i); it; ++it) {
+      a.emplace_back(i, static_cast<int>(it.col()), it.value());
+      sum += it.value();
+      r += it.value() * (uv.row(it.col()) - uv.row(i));
+    }
+    a.emplace_back(i, i, -sum);
+    worst_residual = std::max(worst_residual, r.norm() / sum);
+  }
+  EXPECT_LT(worst_residual, 1e-10);
+
+  Eigen::SparseMatrix<double> A(n, n);
+  A.setFromTriplets(a.begin(), a.end());
+  Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu(A);
+  ASSERT_EQ(lu.info(), Eigen::Success);
+  const Eigen::MatrixX2d reference = lu.solve(rhs);
+  EXPECT_LT((reference - uv).cwiseAbs().maxCoeff(), 1e-8);
+
+  // Floater: a convex boundary and positive weights give an embedding, no flipped triangle.
+  int positive = 0, negative = 0;
+  for (int f = 0; f < disk.num_faces(); ++f) {
+    const Eigen::Vector2d p = uv.row(disk.F(f, 0)), q = uv.row(disk.F(f, 1)), r = uv.row(disk.F(f, 2));
+    const double orientation = (q - p).x() * (r - p).y() - (q - p).y() * (r - p).x();
+    (orientation > 0 ? positive : negative)++;
+  }
+  EXPECT_TRUE(positive == 0 || negative == 0) << positive << " vs " << negative;
+}
