@@ -51,9 +51,11 @@ int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh&
     std::vector<int> fill(under_offset.begin(), under_offset.end() - 1);
     for (int s = 0; s < input_vertices; ++s) under[fill[nearest_face[s]]++] = s;
   }
+  const double largest = *std::max_element(distance.begin(), distance.end());
+  const double far_threshold = std::max(threshold, options.min_share_of_largest * largest);
   std::vector<int> far;
   for (int s = 0; s < input_vertices; ++s)
-    if (distance[s] > threshold && face_of[s] >= 0 && !input_rim[s]) far.push_back(s);
+    if (distance[s] > far_threshold && face_of[s] >= 0 && !input_rim[s]) far.push_back(s);
   std::sort(far.begin(), far.end(), [&](int a, int b) { return distance[a] > distance[b] || (distance[a] == distance[b] && a < b); });
 
   // The faces of v's star and of its neighbours' stars: the triangles a move of v can change
@@ -109,6 +111,8 @@ int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh&
     return smallest;
   };
   std::vector<bool> moved(n, false);
+  const RowMatrixX3d U_before = U, X_before = X;
+  const std::vector<int> hints_before = hints;
   int snaps = 0, judged = 0;
   const int max_judged = 8 * options.max_snaps;  // the region error is the costly part
   for (int s : far) {
@@ -143,9 +147,20 @@ int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh&
     X.row(v) = x.transpose();
     hints[v] = face_of[s];
     moved[v] = true;
-    if (snapped) (*snapped)[v] = true;
     ++snaps;
   }
+  // The snaps cost triangle quality: keep them only if they really bring the input closer
+  // overall (the largest distance drops), not only around each snapped vertex.
+  if (snaps > 0) {
+    const double largest_after = SurfaceLocator(TriMesh{X, F}).distances(surface_V).maxCoeff();
+    if (!(largest_after <= (1 - options.min_gain) * largest)) {
+      U = U_before;
+      X = X_before;
+      hints = hints_before;
+      return 0;
+    }
+  }
+  if (snapped) *snapped = moved;
   return snaps;
 }
 

@@ -8,7 +8,9 @@
 /// vertex's triangles with Q >= min_quality and angles >= min_angle_deg, and really brings the
 /// input around the vertex closer to the level (moving a vertex onto a tip also moves its
 /// triangles off the input it stood on). A tip is judged by its distance to the level as it is
-/// when its turn comes, after the snaps before it.
+/// when its turn comes, after the snaps before it. Snaps cost triangle quality, so only tips
+/// that set the Hausdorff distance are tried, and all snaps are undone unless together they
+/// lower the largest input-to-level distance.
 #include <vector>
 
 #include "mesh/trimesh.h"
@@ -22,14 +24,20 @@ struct FeatureSnapOptions {
   double min_quality = 0.65;     ///< the moved vertex's triangles keep Q >= this
   double min_angle_deg = 32;     ///< and angles >= this (the repair after it keeps snapped tips fixed)
   /// A snap of v must lower the largest distance from the input vertices near v (those whose
-  /// nearest level face is around v or its neighbours) to the level by at least this fraction.
+  /// nearest level face is around v or its neighbours) to the level by at least this fraction,
+  /// and all snaps together the largest distance from the whole input.
   double min_gain = 0.25;
+  /// Only tips at least this fraction of the largest input-to-level distance away: the ones
+  /// that make the Hausdorff distance (a snap costs triangle quality).
+  double min_share_of_largest = 0.5;
 };
 
 /// Snaps vertices of (U, F) (lifted X) onto the input vertices farthest from (X, F).
 /// \pre X = lift of U onto the surface whose domain mesh is `param` (3D positions surface_V);
 ///      no triangle of (U, F) flipped in D; hints has one face of `param` per vertex.
 /// \post no triangle flipped in D; every moved vertex is exactly an input vertex (U and X);
+///       if any moved, the largest distance from the input vertices to the level went down
+///       by at least min_gain (else nothing moved: U, X and hints are as they were);
 ///       disk rim vertices do not move; if `snapped` is given it has one entry per vertex, true
 ///       for the vertices moved (to keep them fixed in the repair after).
 /// \return the number of vertices moved.

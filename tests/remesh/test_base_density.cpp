@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -212,6 +213,30 @@ TEST(TriangleRepair, KeepsFixedVerticesInPlace) {
   EXPECT_GT(fixed_would_move, 0);
 }
 
+
+// Whatever the options, snaps are kept only if together they lower the largest input-to-level
+// distance by min_gain; otherwise nothing moves.
+TEST(FeatureSnap, KeepsSnapsOnlyIfTheLargestDistanceDrops) {
+  int kept = 0;
+  for (const double share : {0.0, 0.5, 0.9})
+    for (const double gain : {0.05, 0.25, 0.6}) {
+      SCOPED_TRACE(std::to_string(share) + " " + std::to_string(gain));
+      EllipsoidLayout s(2);
+      const EllipsoidLayout before(2);
+      FeatureSnapOptions options;
+      options.min_share_of_largest = share;
+      options.min_gain = gain;
+      const double largest = SurfaceLocator(TriMesh{s.X, s.grid.F}).distances(s.param.surface.V).maxCoeff();
+      const int snaps = snap_to_input_tips(DomainKind::sphere, s.grid.F, s.domain, s.param.surface.V, s.U, s.X, s.hints, options);
+      if (snaps == 0) {
+        EXPECT_TRUE(s.U == before.U && s.X == before.X && s.hints == before.hints);
+        continue;
+      }
+      ++kept;
+      EXPECT_LE(SurfaceLocator(TriMesh{s.X, s.grid.F}).distances(s.param.surface.V).maxCoeff(), (1 - gain) * largest + 1e-12);
+    }
+  EXPECT_GT(kept, 0);
+}
 // snap_tips = 0 in the remesher: no vertex snaps (snapped_vertices 0 on every level).
 TEST(FeatureSnap, RemeshWithZeroSnapTipsSnapsNothing) {
   RemeshOptions o;
