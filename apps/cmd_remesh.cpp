@@ -54,20 +54,20 @@ void add_remesh_command(CLI::App& app) {
   cmd->add_option("--curvature-weight", args->curvature, "Denser where the surface bends: 3D density 1 + w·κ/mean κ (default 1; 0 = even spacing)")
       ->check(CLI::Range(0.0, 100.0));
   cmd->add_option("--curvature-exponent", args->curvature_exponent,
-                  "Curvature sizing exponent p: 3D density 1 + w·(κ/mean κ)^p (default " +
+                  "Curvature sizing exponent p: 3D density 1 + w·min((κ/mean κ)^p, 3) (default " +
                       std::to_string(RemeshOptions{}.curvature_exponent).substr(0, 4) + ")")
       ->check(CLI::Range(0.01, 4.0));
   cmd->add_option("--surface-relax-iterations", args->surface_relax_iterations,
                   "Iterations per level of tangential relaxation on the surface after the shape smoothing (default " +
-                      std::to_string(RemeshOptions{}.surface_relax_iterations) + "; 0 = off)")
+                      std::to_string(RemeshOptions{}.surface_relax_iterations) + "; 0 = off; not with --strict or --no-relax)")
       ->check(CLI::Range(0, 1000));
   cmd->add_option("--surface-relax-floor", args->surface_relax_floor,
                   "Surface relaxation moves may not lower a vertex's worst triangle quality below min(before, this) (default " +
-                      std::to_string(RemeshOptions{}.surface_relax_quality_floor).substr(0, 4) + "; 0 = no check)")
+                      std::to_string(RemeshOptions{}.surface_relax_quality_floor).substr(0, 4) + "; 0 = no check; not with --strict or --no-relax)")
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("--smooth-rim,!--no-smooth-rim", args->smooth_rim,
                 std::string("Disk inputs: rim vertices slide along the rim during smoothing (default ") +
-                    (RemeshOptions{}.smooth_rim ? "on" : "off") + ")");
+                    (RemeshOptions{}.smooth_rim ? "on" : "off") + "; not with --strict or --no-relax)");
   cmd->add_option("--base-density-exponent", args->base_density_exponent,
                   "Base vertices closer where the surface bends: farthest-point distances scaled by the curvature sizing^e "
                   "(default " + std::to_string(RemeshOptions{}.base_density_exponent).substr(0, 4) + "; 0 = even)")
@@ -78,7 +78,7 @@ void add_remesh_command(CLI::App& app) {
       ->check(CLI::Range(-1, 1000));
   cmd->add_option("--snap-tips", args->snap_tips,
                   "Finest level: up to this many vertices snap onto the input's vertices farthest from it (default " +
-                      std::to_string(RemeshOptions{}.snap_tips) + "; 0 = off)")
+                      std::to_string(RemeshOptions{}.snap_tips) + "; 0 = off; not with --strict or --no-relax)")
       ->check(CLI::Range(0, 100000));
   cmd->add_option("--iterations", args->iterations, "Lloyd iterations per level (default 8)")->check(CLI::Range(0, 1000));
   cmd->add_option("--shape-iterations", args->shape_iterations,

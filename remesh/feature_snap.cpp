@@ -6,47 +6,94 @@
 #include <utility>
 
 #include "mesh/distance.h"
-#include "mesh/quality.h"
 #include "remesh/surface_moves.h"
 
 namespace mrsnake {
 
 int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh& param, const RowMatrixX3d& surface_V,
-                       RowMatrixX3d& U, RowMatrixX3d& X, std::vector<int>& hints, const FeatureSnapOptions& options) {
+                       RowMatrixX3d& U, RowMatrixX3d& X, std::vector<int>& hints, const FeatureSnapOptions& options,
+                       std::vector<bool>* snapped) {
   const int n = static_cast<int>(U.rows());
   const int m = static_cast<int>(F.rows());
+  if (snapped) snapped->assign(n, false);
   if (m == 0 || options.max_snaps <= 0) return 0;
   const std::vector<bool> rim = kind == DomainKind::disk ? boundary_vertices(F, n) : std::vector<bool>(n, false);
   const VertexStars stars(F, n);
   const auto& PF = param.faces();
   const auto& PD = param.positions();
+  const int input_vertices = static_cast<int>(PD.rows());
   const std::vector<bool> input_rim =
-      kind == DomainKind::disk ? boundary_vertices(PF, static_cast<int>(PD.rows())) : std::vector<bool>(PD.rows(), false);
-  std::vector<int> face_of(PD.rows(), -1);  // one face of the input around each of its vertices
+      kind == DomainKind::disk ? boundary_vertices(PF, input_vertices) : std::vector<bool>(input_vertices, false);
+  std::vector<int> face_of(input_vertices, -1);  // one face of the input around each of its vertices
   for (int f = 0; f < PF.rows(); ++f)
     for (int k = 0; k < 3; ++k) face_of[PF(f, k)] = f;
   double mean_edge = 0;
   for (int f = 0; f < m; ++f)
     for (int k = 0; k < 3; ++k) mean_edge += (X.row(F(f, k)) - X.row(F(f, (k + 1) % 3))).norm();
   mean_edge /= 3.0 * m;
+  const double threshold = options.min_distance * mean_edge;
 
+  // The level face nearest to each input vertex, before any snap; the input vertices under
+  // each level face (so that a snap can be judged on the input around it).
   const SurfaceLocator level(TriMesh{X, F});
-  const Eigen::VectorXd distance = level.distances(surface_V);
+  std::vector<int> nearest_face(input_vertices);
+  std::vector<double> distance(input_vertices);
+  for (int s = 0; s < input_vertices; ++s) {
+    const SurfaceLocator::Hit hit = level.closest(surface_V.row(s).transpose());
+    nearest_face[s] = hit.face;
+    distance[s] = hit.distance;
+  }
+  std::vector<int> under_offset(m + 1, 0), under;
+  for (int s = 0; s < input_vertices; ++s) ++under_offset[nearest_face[s] + 1];
+  for (int f = 0; f < m; ++f) under_offset[f + 1] += under_offset[f];
+  under.resize(under_offset[m]);
+  {
+    std::vector<int> fill(under_offset.begin(), under_offset.end() - 1);
+    for (int s = 0; s < input_vertices; ++s) under[fill[nearest_face[s]]++] = s;
+  }
+  const double largest = *std::max_element(distance.begin(), distance.end());
+  const double far_threshold = std::max(threshold, options.min_share_of_largest * largest);
   std::vector<int> far;
-  for (int s = 0; s < distance.size(); ++s)
-    if (distance[s] > options.min_distance * mean_edge && face_of[s] >= 0 && !input_rim[s]) far.push_back(s);
+  for (int s = 0; s < input_vertices; ++s)
+    if (distance[s] > far_threshold && face_of[s] >= 0 && !input_rim[s]) far.push_back(s);
   std::sort(far.begin(), far.end(), [&](int a, int b) { return distance[a] > distance[b] || (distance[a] == distance[b] && a < b); });
 
-  auto star_quality = [&](int v, const Eigen::Vector3d& x) {
-    double q = 1;
-    for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
-      const int f = stars.faces[i];
+  // The faces of v's star and of its neighbours' stars: the triangles a move of v can change
+  // the nearest point on, for the input near v.
+  std::vector<int> region, region_mark(m, -1);
+  int stamp = 0;
+  auto collect_region = [&](int v) {
+    region.clear();
+    ++stamp;
+    for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i)
+      for (int k = 0; k < 3; ++k) {
+        const int w = F(stars.faces[i], k);
+        for (int j = stars.offset[w]; j < stars.offset[w + 1]; ++j) {
+          const int f = stars.faces[j];
+          if (region_mark[f] == stamp) continue;
+          region_mark[f] = stamp;
+          region.push_back(f);
+        }
+      }
+  };
+  // Distance from p to the region's triangles with v at x.
+  auto region_distance = [&](const Eigen::Vector3d& p, int v, const Eigen::Vector3d& x) {
+    double d = std::numeric_limits<double>::infinity();
+    for (int f : region) {
       Eigen::Vector3d P[3] = {X.row(F(f, 0)), X.row(F(f, 1)), X.row(F(f, 2))};
       for (int k = 0; k < 3; ++k)
         if (F(f, k) == v) P[k] = x;
-      q = std::min(q, frey_borouchaki_quality(P[0], P[1], P[2]));
+      d = std::min(d, point_triangle_distance(p, P[0], P[1], P[2]));
     }
-    return q;
+    return d;
+  };
+  // The largest distance from the input vertices under the region to its triangles, v at x.
+  auto region_error = [&](int v, const Eigen::Vector3d& x) {
+    double error = 0;
+    for (int f : region)
+      for (int i = under_offset[f]; i < under_offset[f + 1]; ++i)
+        error = std::max(error, region_distance(surface_V.row(under[i]).transpose(), v, x));
+    return error;
   };
   // Smallest angle (degrees) of v's triangles with v at x.
   auto star_angle = [&](int v, const Eigen::Vector3d& x) {
@@ -64,15 +111,18 @@ int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh&
     return smallest;
   };
   std::vector<bool> moved(n, false);
-  int snaps = 0;
+  const RowMatrixX3d U_before = U, X_before = X;
+  const std::vector<int> hints_before = hints;
+  int snaps = 0, judged = 0;
+  const int max_judged = 8 * options.max_snaps;  // the region error is the costly part
   for (int s : far) {
-    if (snaps >= options.max_snaps) break;
+    if (snaps >= options.max_snaps || judged >= max_judged) break;
     // The level vertex nearest the tip: the closest corner of the level face nearest to it.
-    const SurfaceLocator::Hit hit = level.closest(surface_V.row(s).transpose());
+    const int face = nearest_face[s];
     int v = -1;
     double best = std::numeric_limits<double>::infinity();
     for (int k = 0; k < 3; ++k) {
-      const int w = F(hit.face, k);
+      const int w = F(face, k);
       const double d = (X.row(w) - surface_V.row(s)).squaredNorm();
       if (d < best) {
         best = d;
@@ -80,16 +130,37 @@ int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh&
       }
     }
     if (v < 0 || moved[v] || rim[v]) continue;
-    const Eigen::Vector3d u = project_to_domain(kind, PD.row(s).transpose(), false);
     const Eigen::Vector3d x = surface_V.row(s).transpose();
+    const Eigen::Vector3d x_old = X.row(v).transpose();
+    collect_region(v);
+    // An earlier snap nearby may have fixed this tip already: its distance now, not before.
+    if (!(region_distance(x, v, x_old) > threshold)) continue;
+    const Eigen::Vector3d u = project_to_domain(kind, PD.row(s).transpose(), false);
     if (!star_unflipped_in_domain(U, F, stars, v, u)) continue;
-    if (star_quality(v, x) < options.min_quality || star_angle(v, x) < options.min_angle_deg) continue;
+    if (star_quality(X, F, stars, v, x) < options.min_quality || star_angle(v, x) < options.min_angle_deg) continue;
+    // Worth it only if the input around v ends up really closer to the level: moving v onto s
+    // also moves its triangles away from the input v stood on.
+    ++judged;
+    const double before = region_error(v, x_old), after = region_error(v, x);
+    if (!(after <= (1 - options.min_gain) * before)) continue;
     U.row(v) = u.transpose();
     X.row(v) = x.transpose();
     hints[v] = face_of[s];
     moved[v] = true;
     ++snaps;
   }
+  // The snaps cost triangle quality: keep them only if they really bring the input closer
+  // overall (the largest distance drops), not only around each snapped vertex.
+  if (snaps > 0) {
+    const double largest_after = SurfaceLocator(TriMesh{X, F}).distances(surface_V).maxCoeff();
+    if (!(largest_after <= (1 - options.min_gain) * largest)) {
+      U = U_before;
+      X = X_before;
+      hints = hints_before;
+      return 0;
+    }
+  }
+  if (snapped) *snapped = moved;
   return snaps;
 }
 

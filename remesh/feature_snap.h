@@ -4,8 +4,13 @@
 /// centroid of its cell, so no vertex stays on a sharp tip of the input and the level cuts it
 /// off: the Hausdorff distance is then that tip's height. This step finds the input vertices
 /// farthest from the level (worst first) and moves the nearest level vertex onto each, in D
-/// (exact lift: the vertex is the input vertex), when that flips nothing in D and leaves the
-/// vertex's triangles with Q >= min_quality and angles >= min_angle_deg.
+/// (exact lift: the vertex is the input vertex), when that flips nothing in D, leaves the
+/// vertex's triangles with Q >= min_quality and angles >= min_angle_deg, and really brings the
+/// input around the vertex closer to the level (moving a vertex onto a tip also moves its
+/// triangles off the input it stood on). A tip is judged by its distance to the level as it is
+/// when its turn comes, after the snaps before it. Snaps cost triangle quality, so only tips
+/// that set the Hausdorff distance are tried, and all snaps are undone unless together they
+/// lower the largest input-to-level distance.
 #include <vector>
 
 #include "mesh/trimesh.h"
@@ -17,16 +22,28 @@ struct FeatureSnapOptions {
   int max_snaps = 32;            ///< at most this many vertices move
   double min_distance = 0.1;     ///< only input vertices farther than this x the mean edge length
   double min_quality = 0.65;     ///< the moved vertex's triangles keep Q >= this
-  double min_angle_deg = 32;     ///< and angles >= this (the repair after it cannot move a snapped tip)
+  double min_angle_deg = 32;     ///< and angles >= this (the repair after it keeps snapped tips fixed)
+  /// A snap of v must lower the largest distance from the input vertices near v (those whose
+  /// nearest level face is around v or its neighbours) to the level by at least this fraction,
+  /// and all snaps together the largest distance from the whole input.
+  double min_gain = 0.25;
+  /// Only tips at least this fraction of the largest input-to-level distance away: the ones
+  /// that make the Hausdorff distance (a snap costs triangle quality).
+  double min_share_of_largest = 0.5;
 };
 
 /// Snaps vertices of (U, F) (lifted X) onto the input vertices farthest from (X, F).
 /// \pre X = lift of U onto the surface whose domain mesh is `param` (3D positions surface_V);
 ///      no triangle of (U, F) flipped in D; hints has one face of `param` per vertex.
 /// \post no triangle flipped in D; every moved vertex is exactly an input vertex (U and X);
-///       disk rim vertices do not move.
+///       if any moved, the largest distance from the input vertices to the level went down
+///       by at least min_gain (else nothing moved: U, X and hints are as they were);
+///       disk rim vertices do not move; if `snapped` is given it has one entry per vertex, true
+///       for the vertices moved (to keep them fixed in the repair after).
 /// \return the number of vertices moved.
+/// \throw nothing beyond std::bad_alloc (a tip whose snap is not worth it is left alone).
 int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh& param, const RowMatrixX3d& surface_V,
-                       RowMatrixX3d& U, RowMatrixX3d& X, std::vector<int>& hints, const FeatureSnapOptions& options);
+                       RowMatrixX3d& U, RowMatrixX3d& X, std::vector<int>& hints, const FeatureSnapOptions& options,
+                       std::vector<bool>* snapped = nullptr);
 
 }  // namespace mrsnake

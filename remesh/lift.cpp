@@ -13,8 +13,7 @@ RowMatrixX3d lift_to_surface(const DomainMesh& param, const RowMatrixX3d& surfac
     for (auto v = static_cast<Eigen::Index>(begin); v < static_cast<Eigen::Index>(end); ++v) {
       const DomainMesh::Location loc = param.locate(U.row(v).transpose(), hints[v]);
       hints[v] = loc.face;
-      X.row(v) = loc.barycentric[0] * surface_V.row(F(loc.face, 0)) +
-                 loc.barycentric[1] * surface_V.row(F(loc.face, 1)) + loc.barycentric[2] * surface_V.row(F(loc.face, 2));
+      X.row(v) = lift_location(surface_V, F, loc).transpose();
     }
   });
   return X;

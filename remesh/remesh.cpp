@@ -189,12 +189,6 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       shape.iterations = 1;
       shape.move_rim = options.smooth_rim;
       lloyd.first_movable = 0;
-      ShapeSmoothingOptions surface;
-      surface.iterations = options.surface_relax_iterations;
-      surface.target = SmoothingTarget::area_centroid;
-      surface.surface_density = &wanted;
-      surface.move_rim = options.smooth_rim;
-      surface.quality_floor = options.surface_relax_quality_floor;
       for (int round = 0; round < rounds; ++round) {
         lloyd.iterations = options.lloyd_iterations * (round + 1) / rounds - options.lloyd_iterations * round / rounds;
         const LloydStats s = constrained_lloyd(kind, F, density, U, hints, lloyd);
@@ -205,10 +199,6 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
         level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
         shape_moves += smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, shape);
       }
-      // Sizes last: the area-centroid target evens out what the Lloyd step in D left uneven
-      // where the stretch changes fast; its quality floor keeps the shapes just made.
-      if (surface.iterations > 0)
-        shape_moves += smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, surface);
     } else {
       const bool relax = options.relax == RelaxMode::all_vertices ||
                          (options.relax == RelaxMode::new_vertices_only && j > 0);
@@ -219,11 +209,23 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       }
       level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
     }
+    // Sizes last: the area-centroid target evens out what the Lloyd step in D left uneven
+    // where the stretch changes fast; its quality floor keeps the shapes just made.
+    if (options.relax == RelaxMode::all_vertices && options.surface_relax_iterations > 0) {
+      ShapeSmoothingOptions surface;
+      surface.iterations = options.surface_relax_iterations;
+      surface.target = SmoothingTarget::area_centroid;
+      surface.surface_density = &wanted;
+      surface.move_rim = options.smooth_rim;
+      surface.quality_floor = options.surface_relax_quality_floor;
+      shape_moves += smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, surface);
+    }
     int snapped = 0;
+    std::vector<bool> snapped_mask;
     if (options.relax == RelaxMode::all_vertices && options.snap_tips > 0 && j == levels) {
       FeatureSnapOptions snap;
       snap.max_snaps = options.snap_tips;
-      snapped = snap_to_input_tips(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, snap);
+      snapped = snap_to_input_tips(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, snap, &snapped_mask);
     }
     // Onto the original input before the repair, so that the repair sees (and keeps) the
     // final triangles: the projection onto a marching-cubes staircase shears a few of them.
@@ -238,6 +240,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       repair_options.guard_surface_error = options.repair_guard_finest && j == levels && !project_first;
       repair_options.error_tolerance = options.repair_error_tolerance;
       if (project_first) repair_options.project_onto = reproject.get();
+      if (snapped > 0) repair_options.fixed = &snapped_mask;  // the tips stay exactly on the input
       repair = repair_worst_triangles(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, repair_options);
     }
     report(options.progress, "level " + std::to_string(j), 0.5);

@@ -8,7 +8,7 @@
 
 #include <Eigen/Dense>
 
-#include "mesh/quality.h"
+#include "remesh/lift.h"
 #include "remesh/surface_moves.h"
 
 namespace mrsnake {
@@ -57,18 +57,6 @@ int smooth_shapes_in_domain(DomainKind kind, const RowMatrixX3i& F, const Domain
            loc.barycentric[2] * w[PF(loc.face, 2)];
   };
   Eigen::VectorXd vertex_density = Eigen::VectorXd::Ones(n);
-  // Smallest Q of v's triangles with v at x in 3D.
-  auto star_quality = [&](int v, const Eigen::Vector3d& x) {
-    double q = 1;
-    for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
-      const int f = stars.faces[i];
-      Eigen::Vector3d P[3] = {X.row(F(f, 0)), X.row(F(f, 1)), X.row(F(f, 2))};
-      for (int k = 0; k < 3; ++k)
-        if (F(f, k) == v) P[k] = x;
-      q = std::min(q, frey_borouchaki_quality(P[0], P[1], P[2]));
-    }
-    return q;
-  };
   int moves = 0;
   for (int it = 0; it < options.iterations; ++it) {
     if (weighted)
@@ -117,16 +105,14 @@ int smooth_shapes_in_domain(DomainKind kind, const RowMatrixX3i& F, const Domain
       if (!pullback) continue;
       const Eigen::Vector3d domain_move = pullback->to_domain(move);
       const Eigen::Vector3d current = U.row(v);
-      const double floor = options.quality_floor > 0 ? std::min(star_quality(v, x), options.quality_floor) : 0.0;
+      const double floor = options.quality_floor > 0 ? std::min(star_quality(X, F, stars, v, x), options.quality_floor) : 0.0;
       double t = options.step;
       for (int attempt = 0; attempt < 8; ++attempt, t *= 0.5) {
         const Eigen::Vector3d candidate = project_to_domain(kind, current + t * domain_move, on_rim);
         if (!star_unflipped_in_domain(U, F, stars, v, candidate)) continue;
         const DomainMesh::Location loc = param.locate(candidate, hints[v]);
-        const Eigen::Vector3d lifted = loc.barycentric[0] * surface_V.row(PF(loc.face, 0)).transpose() +
-                                       loc.barycentric[1] * surface_V.row(PF(loc.face, 1)).transpose() +
-                                       loc.barycentric[2] * surface_V.row(PF(loc.face, 2)).transpose();
-        if (options.quality_floor > 0 && star_quality(v, lifted) < floor) continue;
+        const Eigen::Vector3d lifted = lift_location(surface_V, PF, loc);
+        if (options.quality_floor > 0 && star_quality(X, F, stars, v, lifted) < floor) continue;
         hints[v] = loc.face;
         U.row(v) = candidate.transpose();
         X.row(v) = lifted.transpose();

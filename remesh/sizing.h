@@ -16,6 +16,7 @@ Eigen::VectorXd vertex_curvature(const TriMesh& mesh, int smoothing = 3);
 /// `field` (one value per vertex) averaged `passes` times over each vertex's 1-ring (itself
 /// included, each neighbour once per incident edge side).
 /// \pre field has one entry per vertex of mesh; passes >= 0.
+/// \throw nothing beyond std::bad_alloc (passes <= 0 returns field unchanged).
 Eigen::VectorXd smooth_vertex_field(const TriMesh& mesh, Eigen::VectorXd field, int passes);
 
 }  // namespace mrsnake

@@ -2,13 +2,17 @@
 /// \file surface_moves.h
 /// Small pieces shared by the steps that move the vertices of a level over the input surface in
 /// 3D and carry each move back to the parameter domain D (shape_smoothing.h, triangle_repair.h):
-/// the vertex normal, the no-flip check of a vertex's star in D, the equilateral apex of an edge, and the
-/// pull-back of a 3D move through the affine map of one input triangle.
+/// the vertex normal, the no-flip check of a vertex's star in D, the smallest quality of a star,
+/// the point-triangle distance, the equilateral apex of an edge, and the pull-back of a 3D move
+/// through the affine map of one input triangle.
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include <Eigen/Dense>
 
+#include "mesh/quality.h"
 #include "mesh/trimesh.h"
 #include "mesh/vertex_stars.h"
 #include "remesh/domain.h"
@@ -38,6 +42,44 @@ inline bool star_unflipped_in_domain(const RowMatrixX3d& U, const RowMatrixX3i& 
     if (!(domain_orientation(P[0], P[1], P[2]) > 0)) return false;
   }
   return true;
+}
+
+/// Smallest Frey–Borouchaki Q of v's triangles in (X, F) with v put at x; +infinity if v has
+/// no triangle (nothing to make worse).
+inline double star_quality(const RowMatrixX3d& X, const RowMatrixX3i& F, const VertexStars& stars, int v,
+                           const Eigen::Vector3d& x) {
+  double q = std::numeric_limits<double>::infinity();
+  for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
+    const int f = stars.faces[i];
+    Eigen::Vector3d P[3] = {X.row(F(f, 0)), X.row(F(f, 1)), X.row(F(f, 2))};
+    for (int k = 0; k < 3; ++k)
+      if (F(f, k) == v) P[k] = x;
+    q = std::min(q, frey_borouchaki_quality(P[0], P[1], P[2]));
+  }
+  return q;
+}
+
+/// Distance from p to the triangle (a, b, c) (Ericson, Real-Time Collision Detection, 5.1.5).
+inline double point_triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                      const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return ap.norm();
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return bp.norm();
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (p - (a + d1 / (d1 - d3) * ab)).norm();
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return cp.norm();
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + d2 / (d2 - d6) * ac)).norm();
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return (p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
+  const double denom = 1.0 / (va + vb + vc);
+  return (p - (a + ab * (vb * denom) + ac * (vc * denom))).norm();
 }
 
 /// The apex of the equilateral triangle on edge a → b, on the side where a vertex with outward

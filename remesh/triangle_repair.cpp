@@ -9,36 +9,10 @@
 #include <Eigen/Dense>
 
 #include "mesh/quality.h"
+#include "remesh/lift.h"
 #include "remesh/surface_moves.h"
 
 namespace mrsnake {
-namespace {
-
-// Distance from p to the triangle (a, b, c) (Ericson, Real-Time Collision Detection, 5.1.5).
-double point_triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                               const Eigen::Vector3d& c) {
-  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return ap.norm();
-  const Eigen::Vector3d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return bp.norm();
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (p - (a + d1 / (d1 - d3) * ab)).norm();
-  const Eigen::Vector3d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return cp.norm();
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + d2 / (d2 - d6) * ac)).norm();
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return (p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
-  const double denom = 1.0 / (va + vb + vc);
-  return (p - (a + ab * (vb * denom) + ac * (vc * denom))).norm();
-}
-
-}  // namespace
-
 TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& F, const DomainMesh& param,
                                            const RowMatrixX3d& surface_V, RowMatrixX3d& U, RowMatrixX3d& X,
                                            std::vector<int>& hints, const TriangleRepairOptions& options) {
@@ -54,18 +28,10 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
       if (F(f, k) == v) P[k] = x;
     return frey_borouchaki_quality(P[0], P[1], P[2]);
   };
-  // Smallest Q of v's triangles with v at x.
-  auto star_quality = [&](int v, const Eigen::Vector3d& x) {
-    double q = std::numeric_limits<double>::infinity();
-    for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) q = std::min(q, quality(stars.faces[i], v, x));
-    return q;
-  };
   auto lift = [&](const Eigen::Vector3d& u, int& hint) {
     const DomainMesh::Location loc = param.locate(u, hint);
     hint = loc.face;
-    const Eigen::Vector3d lifted = loc.barycentric[0] * surface_V.row(PF(loc.face, 0)).transpose() +
-                                   loc.barycentric[1] * surface_V.row(PF(loc.face, 1)).transpose() +
-                                   loc.barycentric[2] * surface_V.row(PF(loc.face, 2)).transpose();
+    const Eigen::Vector3d lifted = lift_location(surface_V, PF, loc);
     return options.project_onto ? Eigen::Vector3d(options.project_onto->closest(lifted).point) : lifted;
   };
   // How far v's triangles (v at u in D, x in 3D) leave the surface: the largest distance
@@ -113,9 +79,10 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
       for (int corner = 0; corner < 3; ++corner) {
         const int v = F(face, corner);
         if (visited[v] == sweep || (boundary[v] && !options.move_rim)) continue;
+        if (options.fixed && (*options.fixed)[v]) continue;
         visited[v] = sweep;
         const Eigen::Vector3d x = X.row(v);
-        const double current = star_quality(v, x);
+        const double current = star_quality(X, F, stars, v, x);
         if (!(current < options.threshold)) continue;
         const std::optional<Eigen::Vector3d> normal = vertex_normal(X, F, stars, v);
         if (!normal) continue;
@@ -158,7 +125,7 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
             if (!star_unflipped_in_domain(U, F, stars, v, candidate)) continue;
             int hint = hints[v];
             const Eigen::Vector3d lifted = lift(candidate, hint);
-            const double q = star_quality(v, lifted);
+            const double q = star_quality(X, F, stars, v, lifted);
             if (!(q > best + 1e-9)) continue;
             if (options.guard_surface_error && surface_error(v, candidate, lifted, x) > allowed_error) continue;
             best = q;

@@ -34,6 +34,9 @@ struct TriangleRepairOptions {
   /// original input when the parameterized surface is a simplification of it): the repair
   /// then judges and keeps the triangles as they will finally be. X must already be on it.
   const SurfaceLocator* project_onto = nullptr;
+  /// If set (one entry per vertex), vertices marked true never move: the tips that
+  /// snap_to_input_tips put exactly on the input.
+  const std::vector<bool>* fixed = nullptr;
 };
 
 struct TriangleRepairStats {
@@ -45,8 +48,10 @@ struct TriangleRepairStats {
 /// Repairs the worst triangles of (X, F) by moving vertices tangentially; updates U, X and hints.
 /// \pre X = lift of U onto the surface whose domain mesh is `param` (3D positions surface_V),
 ///      then projected onto options.project_onto if set;
-///      no triangle of (U, F) flipped in D; hints has one face of `param` per vertex.
-/// \post no triangle of (U, F) is flipped in D; the smallest Q of every moved vertex's
+///      no triangle of (U, F) flipped in D; hints has one face of `param` per vertex; a fixed
+///      mask has one entry per vertex.
+/// \post no triangle of (U, F) is flipped in D; vertices marked in options.fixed keep U, X and
+///       hints; the smallest Q of every moved vertex's
 ///       triangles went up, so the mesh's smallest Q never goes down; with
 ///       guard_surface_error and error_tolerance 0 the largest edge-midpoint distance to the
 ///       surface never goes up either.

@@ -3,8 +3,11 @@
 // original input of a simplified one).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "mesh/distance.h"
@@ -15,6 +18,7 @@
 #include "remesh/feature_snap.h"
 #include "remesh/lift.h"
 #include "remesh/parameterization.h"
+#include "remesh/remesh.h"
 #include "remesh/sizing.h"
 #include "remesh/triangle_repair.h"
 #include "tests/remesh/remesh_shapes.h"
@@ -22,6 +26,7 @@
 namespace mrsnake {
 namespace {
 
+using test::EllipsoidLayout;
 using test::ellipsoid;
 
 // Point density 4 on the x > 0 half: farthest points with squared distances scaled by it
@@ -84,14 +89,8 @@ TEST(TriangleRepair, ProjectsItsMovesOntoTheOriginalInput) {
   const DomainMesh domain(param.domain, param.surface.F);
   const SurfaceLocator on_fine(fine);
   const TriMesh grid = icosphere(3);
-  RowMatrixX3d U = grid.V.rowwise().normalized();
   const RowMatrixX3i& F = grid.F;
-  for (int f = 0; f < 300; f += 30) {
-    const int v = F(f, 0), w = F(f, 1);
-    const Eigen::RowVector3d before = U.row(v);
-    U.row(v) = (0.2 * U.row(v) + 0.8 * U.row(w)).normalized();
-    if (count_flipped(U, F) > 0) U.row(v) = before;
-  }
+  RowMatrixX3d U = test::sheared_layout(grid.V.rowwise().normalized(), F);
   std::vector<int> hints(U.rows(), 0);
   RowMatrixX3d X = lift_to_surface(domain, param.surface.V, U, hints);
   for (int v = 0; v < X.rows(); ++v) X.row(v) = on_fine.closest(X.row(v).transpose()).point.transpose();
@@ -111,14 +110,12 @@ TEST(TriangleRepair, ProjectsItsMovesOntoTheOriginalInput) {
 // vertices snap exactly onto input vertices, the largest input-to-level distance goes down,
 // nothing flips, and every snapped vertex's triangles keep the quality and angle bounds.
 TEST(FeatureSnap, SnapsVerticesOntoTheTipsTheLevelCutsOff) {
-  const TriMesh input = ellipsoid(4);
-  const Parameterization param = parameterize(input);
-  const DomainMesh domain(param.domain, param.surface.F);
-  const TriMesh grid = icosphere(2);
-  RowMatrixX3d U = grid.V.rowwise().normalized();
-  const RowMatrixX3i& F = grid.F;
-  std::vector<int> hints(U.rows(), 0);
-  RowMatrixX3d X = lift_to_surface(domain, param.surface.V, U, hints);
+  EllipsoidLayout layout(2);
+  const Parameterization& param = layout.param;
+  const DomainMesh& domain = layout.domain;
+  const RowMatrixX3i& F = layout.grid.F;
+  RowMatrixX3d &U = layout.U, &X = layout.X;
+  std::vector<int>& hints = layout.hints;
   const RowMatrixX3d X0 = X;
   const double before = SurfaceLocator(TriMesh{X, F}).distances(param.surface.V).maxCoeff();
   FeatureSnapOptions options;
@@ -146,6 +143,109 @@ TEST(FeatureSnap, SnapsVerticesOntoTheTipsTheLevelCutsOff) {
     }
   }
   EXPECT_EQ(moved, snaps);
+}
+
+// A snap must bring the input around the vertex really closer to the level: asking for the
+// largest distance there to drop to zero refuses every snap (the input between the level's
+// vertices stays off its flat triangles), and leaves U, X and hints as they were; a zero
+// budget snaps nothing either.
+TEST(FeatureSnap, RefusesSnapsThatDoNotBringTheInputCloser) {
+  for (const bool zero_budget : {false, true}) {
+    SCOPED_TRACE(zero_budget);
+    EllipsoidLayout s(2);
+    const EllipsoidLayout before(2);
+    FeatureSnapOptions options;
+    if (zero_budget)
+      options.max_snaps = 0;
+    else
+      options.min_gain = 1.0;
+    std::vector<bool> snapped(3, true);
+    EXPECT_EQ(snap_to_input_tips(DomainKind::sphere, s.grid.F, s.domain, s.param.surface.V, s.U, s.X, s.hints, options,
+                                 &snapped),
+              0);
+    EXPECT_TRUE(s.U == before.U);
+    EXPECT_TRUE(s.X == before.X);
+    EXPECT_TRUE(s.hints == before.hints);
+    EXPECT_EQ(snapped, std::vector<bool>(s.U.rows(), false));
+  }
+}
+
+// The repair keeps the vertices of its fixed mask exactly where they are (U, X and hints),
+// and still repairs the others.
+TEST(TriangleRepair, KeepsFixedVerticesInPlace) {
+  EllipsoidLayout s(3, true);
+  const RowMatrixX3i& F = s.grid.F;
+  RowMatrixX3d &U = s.U, &X = s.X;
+  std::vector<int>& hints = s.hints;
+  // Fix one corner of each of the 5 worst triangles: those the repair would move first.
+  std::vector<std::pair<double, int>> worst;
+  for (int f = 0; f < F.rows(); ++f) worst.emplace_back(mesh_quality(TriMesh{X, RowMatrixX3i(F.row(f))}).q_min, f);
+  std::sort(worst.begin(), worst.end());
+  std::vector<bool> fixed(U.rows(), false);
+  for (int i = 0; i < 5; ++i)
+    for (int k = 0; k < 3; ++k) fixed[F(worst[i].second, k)] = true;
+  const RowMatrixX3d U0 = U, X0 = X;
+  const std::vector<int> hints0 = hints;
+  TriangleRepairOptions options;
+  options.fixed = &fixed;
+  const TriangleRepairStats stats =
+      repair_worst_triangles(DomainKind::sphere, F, s.domain, s.param.surface.V, U, X, hints, options);
+  EXPECT_GT(stats.moves, 0);
+  int moved = 0;
+  for (int v = 0; v < U.rows(); ++v) {
+    if (fixed[v]) {
+      EXPECT_TRUE(U.row(v) == U0.row(v)) << v;
+      EXPECT_TRUE(X.row(v) == X0.row(v)) << v;
+      EXPECT_EQ(hints[v], hints0[v]) << v;
+    } else if (!(X.row(v) == X0.row(v))) {
+      ++moved;
+    }
+  }
+  EXPECT_GT(moved, 0);
+  EXPECT_EQ(count_flipped(U, F), 0);
+  // Without the mask the repair does move some of those vertices.
+  RowMatrixX3d U1 = U0, X1 = X0;
+  std::vector<int> hints1 = hints0;
+  repair_worst_triangles(DomainKind::sphere, F, s.domain, s.param.surface.V, U1, X1, hints1, TriangleRepairOptions{});
+  int fixed_would_move = 0;
+  for (int v = 0; v < U.rows(); ++v)
+    if (fixed[v] && !(X1.row(v) == X0.row(v))) ++fixed_would_move;
+  EXPECT_GT(fixed_would_move, 0);
+}
+
+
+// Whatever the options, snaps are kept only if together they lower the largest input-to-level
+// distance by min_gain; otherwise nothing moves.
+TEST(FeatureSnap, KeepsSnapsOnlyIfTheLargestDistanceDrops) {
+  int kept = 0;
+  for (const double share : {0.0, 0.5, 0.9})
+    for (const double gain : {0.05, 0.25, 0.6}) {
+      SCOPED_TRACE(std::to_string(share) + " " + std::to_string(gain));
+      EllipsoidLayout s(2);
+      const EllipsoidLayout before(2);
+      FeatureSnapOptions options;
+      options.min_share_of_largest = share;
+      options.min_gain = gain;
+      const double largest = SurfaceLocator(TriMesh{s.X, s.grid.F}).distances(s.param.surface.V).maxCoeff();
+      const int snaps = snap_to_input_tips(DomainKind::sphere, s.grid.F, s.domain, s.param.surface.V, s.U, s.X, s.hints, options);
+      if (snaps == 0) {
+        EXPECT_TRUE(s.U == before.U && s.X == before.X && s.hints == before.hints);
+        continue;
+      }
+      ++kept;
+      EXPECT_LE(SurfaceLocator(TriMesh{s.X, s.grid.F}).distances(s.param.surface.V).maxCoeff(), (1 - gain) * largest + 1e-12);
+    }
+  EXPECT_GT(kept, 0);
+}
+// snap_tips = 0 in the remesher: no vertex snaps (snapped_vertices 0 on every level).
+TEST(FeatureSnap, RemeshWithZeroSnapTipsSnapsNothing) {
+  RemeshOptions o;
+  o.levels = 1;
+  o.base_vertices = 20;
+  o.compute_stats = false;
+  o.snap_tips = 0;
+  const RemeshResult r = remesh(ellipsoid(3), o);
+  for (const RemeshLevel& level : r.levels) EXPECT_EQ(level.stats["snapped_vertices"].get<int>(), 0);
 }
 
 }  // namespace

@@ -20,6 +20,7 @@
 namespace mrsnake {
 namespace {
 
+using test::EllipsoidLayout;
 using test::ellipsoid;
 using test::spherical_cap;
 
@@ -41,16 +42,6 @@ double coefficient_of_variation(const std::vector<double>& x) {
 // An even triangulation of the sphere D is uneven on the ellipsoid (the parameterization
 // stretches the ends); the area-centroid target evens out the 3D areas, flips nothing and
 // leaves every vertex the exact lift of its domain position.
-struct EllipsoidLayout {
-  TriMesh input = ellipsoid(4);
-  Parameterization param = parameterize(input);
-  DomainMesh domain{param.domain, param.surface.F};
-  TriMesh grid = icosphere(3);
-  RowMatrixX3d U = grid.V.rowwise().normalized();
-  std::vector<int> hints = std::vector<int>(U.rows(), 0);
-  RowMatrixX3d X = lift_to_surface(domain, param.surface.V, U, hints);
-};
-
 TEST(SurfaceRelaxation, EvensOutTriangleAreasOnTheSurfaceWithoutFlips) {
   EllipsoidLayout s;
   const RowMatrixX3i& F = s.grid.F;
@@ -210,6 +201,31 @@ TEST(SurfaceRelaxation, RimVerticesSlideAlongTheRimAndStayOnTheCircle) {
     // Still on the input (the rim lifts onto the input's boundary polygon).
     const SurfaceLocator locator(input);
     EXPECT_LT(locator.distances(X).maxCoeff(), 1e-9 * bounding_box_diagonal(input.V));
+  }
+}
+
+// The surface relaxation runs whenever all vertices relax, also without shape rounds: with
+// shape_iterations = 0 it still moves vertices (shape_moves counts them, and the positions
+// differ from those without it).
+TEST(SurfaceRelaxation, RunsWithoutShapeIterations) {
+  const TriMesh input = ellipsoid(4);
+  RemeshOptions o;
+  o.levels = 1;
+  o.base_vertices = 20;
+  o.compute_stats = false;
+  o.shape_iterations = 0;
+  o.snap_tips = 0;
+  o.repair_sweeps = 0;
+  o.surface_relax_iterations = 0;
+  const RemeshResult without = remesh(input, o);
+  o.surface_relax_iterations = 3;
+  const RemeshResult with = remesh(input, o);
+  for (int j = 0; j <= 1; ++j) {
+    SCOPED_TRACE(j);
+    EXPECT_EQ(without.levels[j].stats["shape_moves"].get<int>(), 0);
+    EXPECT_GT(with.levels[j].stats["shape_moves"].get<int>(), 0);
+    EXPECT_GT((with.levels[j].positions - without.levels[j].positions).cwiseAbs().maxCoeff(), 1e-6);
+    EXPECT_EQ(count_flipped(with.levels[j].domain_positions, with.connectivity.faces[j]), 0);
   }
 }
 
