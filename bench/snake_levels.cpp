@@ -3,7 +3,8 @@
 // its self-intersection count. Snake options can be overridden to compare settings.
 // Usage: bench_snake_levels IMAGE MODEL_DIR TRUTH [--truth-label L] [--init fit] [key=value ...]
 //   keys: membrane, thin_plate, prior, tangential, external, time_step, max_step, smoothing,
-//         max_iterations, min_iterations, patience, range_fraction, min_range_voxels, max_profile_cost, distance_penalty,
+//         max_iterations, min_iterations, patience, range_fraction, min_range_voxels, max_profile_cost, distance_penalty (profile),
+//         edge_distance_penalty, min_gain,
 //         reg_schedule (shrink factors as digits: 421, 42, 21), reg_iterations, reg_samples,
 //         reg_change, reg_window, reg_min_step, reg_step, reg_eval
 #include <ctime>
@@ -62,7 +63,10 @@ int main(int argc, char** argv) {
                                         {"max_profile_cost", &o.max_profile_cost},
                                         {"profile_step", &o.profile_step_fraction},
                                         {"max_range_voxels", &o.max_range_voxels},
-                                        {"min_edge_voxels", &o.min_edge_voxels}};
+                                        {"min_edge_voxels", &o.min_edge_voxels},
+                                        {"distance_penalty", &o.profile_distance_penalty},
+                                        {"edge_distance_penalty", &o.edge_distance_penalty},
+                                        {"min_gain", &o.search_min_gain}};
     RegistrationOptions& reg = o.registration.itk;
     if (key == "reg_schedule") {  // shrink factors as digits, e.g. 421 (the default), 42, 21
       reg.shrink_factors.clear();

@@ -38,7 +38,7 @@ struct SnakeOptions {
   double thin_plate_weight = 0.05;  ///< β (τ·β must stay below ~0.4)
   double prior_weight = 0.35;       ///< w_p
   double tangential_weight = 0.35;  ///< w_t, towards the model's tangential umbrella (τ·(α + w_p + w_t) must stay below ~1.2)
-  double external_weight = 0.3;     ///< w_e: fraction of the matched offset taken per step
+  double external_weight = 0.35;    ///< w_e: fraction of the matched offset taken per step (segment.h)
   double time_step = 1.0;           ///< τ
   double max_step_fraction = 0.3;   ///< cap on a step, in local edge lengths
   int offset_median = 1;            ///< ring-median passes over the matched offsets (before the averaging)

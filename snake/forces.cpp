@@ -27,6 +27,16 @@ double refine(const std::vector<double>& c, int i, double h) {
   if (!(denom > 0)) return 0.0;
   return std::clamp(0.5 * (a - d) / denom, -0.5, 0.5) * h;
 }
+
+// The candidate of least cost among costs[0..2·nc] (all computed for this vertex), ties
+// resolved towards the centre nc; a move wins over staying (nc) only if it is cheaper by
+// more than min_gain, on either side alike.
+int best_candidate(const std::vector<double>& cost, int nc, double min_gain) {
+  int best = nc;
+  for (int c = 0; c <= 2 * nc; ++c)
+    if (cost[c] < cost[best] || (cost[c] == cost[best] && std::abs(c - nc) < std::abs(best - nc))) best = c;
+  return cost[best] < cost[nc] - min_gain ? best : nc;
+}
 }  // namespace
 
 SearchResult search_step_edges(const VolumeSampler& image, const RowMatrixX3d& V, const RowMatrixX3d& N,
@@ -50,7 +60,6 @@ SearchResult search_step_edges(const VolumeSampler& image, const RowMatrixX3d& V
       in_prefix[s + 1] = in_prefix[s] + (I - stats.inside) * (I - stats.inside);
       out_prefix[s + 1] = out_prefix[s] + (I - stats.outside) * (I - stats.outside);
     }
-    int best = nc;
     for (int c = 0; c <= 2 * nc; ++c) {
       // Candidate boundary at offset (c − nc)·h lies between samples c + w − 1 and c + w.
       const int mid = c + w;
@@ -58,8 +67,10 @@ SearchResult search_step_edges(const VolumeSampler& image, const RowMatrixX3d& V
       const double t = (c - nc) * h;
       const double rel = options.range_mm > 0 ? t / options.range_mm : 0.0;
       cost[c] = misfit * norm + options.distance_penalty * rel * rel;
-      if (cost[c] < cost[best]) best = c;
     }
+    // (The minimum is taken once every candidate's cost is in: comparing during the loop
+    // read cost[nc] of the previous vertex before this one's was written.)
+    const int best = best_candidate(cost, nc, options.min_gain);
     r.offsets[v] = cost[best] <= options.max_cost ? (best - nc) * h + refine(cost, best, h) : 0.0;
     r.costs[v] = cost[best];
   }
@@ -101,7 +112,6 @@ SearchResult search_profiles(const VolumeSampler& image, const RowMatrixX3d& V, 
     for (double& m : model) m *= inv;
     const Eigen::Vector3d x = V.row(v), n = N.row(v);
     for (int s = 0; s < ns; ++s) samples[s] = image.value(x + ((s - nc - sub * half) * h) * n);
-    int best = nc;
     for (int c = 0; c <= 2 * nc; ++c) {
       double sum = 0, sum2 = 0, dot = 0;
       for (int k = 0; k < K; ++k) {
@@ -115,8 +125,8 @@ SearchResult search_profiles(const VolumeSampler& image, const RowMatrixX3d& V, 
       const double t = (c - nc) * h;
       const double rel = options.range_mm > 0 ? t / options.range_mm : 0.0;
       cost[c] = (1.0 - ncc) + options.distance_penalty * rel * rel;
-      if (cost[c] < cost[best]) best = c;
     }
+    const int best = best_candidate(cost, nc, options.min_gain);
     r.offsets[v] = cost[best] <= options.max_cost ? (best - nc) * h + refine(cost, best, h) : 0.0;
     r.costs[v] = cost[best];
   }

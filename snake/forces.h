@@ -22,11 +22,17 @@ struct NormalSearchOptions {
   double window_mm = 3.0;     ///< step_edge: half-width of the step fitted around a candidate
   /// A mild preference for small moves: cost += distance_penalty·(t/range)² in units of the
   /// cost of a full mismatch, so that equally good candidates resolve towards the surface.
+  /// segment() sets it per force (SegmentOptions::profile_distance_penalty, ::edge_distance_penalty).
   double distance_penalty = 0.05;
   /// A best cost above this means "no boundary seen here": the offset is set to 0, so the
   /// vertex follows its neighbours and the prior instead of a random target. On the
   /// normalized step cost, a clean edge at SNR 4 scores ~0.06–0.1 and plain background ~0.5.
   double max_cost = 0.35;
+  /// Hysteresis: a candidate off the centre replaces staying (offset 0) only if its cost is
+  /// lower than the centre's by more than this, inward and outward alike, so that a vertex
+  /// near its boundary does not chase noise-level differences from one iteration to the next.
+  /// Off by default: 0.01–0.04 lowered the Dice of the SNR 2 heart (0.9806 → 0.9782–0.9796).
+  double min_gain = 0.0;
 };
 
 /// Intensities inside the object and just outside it (normalized units).

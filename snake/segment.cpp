@@ -188,10 +188,12 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     const VolumeSampler* sampler = &samplers[p];
     NormalSearchOptions so;
     so.range_mm = range_mm;
+    so.min_gain = options.search_min_gain;
     if (use_profiles) {
       const LevelAppearance* la = &model.appearance->levels[j];
       so.step_mm = options.profile_step_fraction * la->spacing_mm;
       so.max_cost = options.max_profile_cost;
+      so.distance_penalty = options.profile_distance_penalty;
       return {[sampler, la, so](const RowMatrixX3d& V, const RowMatrixX3d& N) {
                 return search_profiles(*sampler, V, N, la->profiles, la->spacing_mm, so);
               },
@@ -200,6 +202,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     so.step_mm = options.step_voxels * spacings[p];
     so.window_mm = options.window_voxels * spacings[p];
     so.max_cost = options.max_edge_cost;
+    so.distance_penalty = options.edge_distance_penalty;
     return {[sampler, stats, so](const RowMatrixX3d& V, const RowMatrixX3d& N) {
               return search_step_edges(*sampler, V, N, stats, so);
             },

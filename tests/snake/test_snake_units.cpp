@@ -452,6 +452,89 @@ TEST(Forces, StepEdgeAndProfileFindAPlaneBoundary) {
   EXPECT_NEAR(st.outside, 0.0, 0.2);
 }
 
+TEST(Forces, EachVertexFindsItsOwnBoundaryWhateverTheVertexBeforeIt) {
+  // Vertex 0 sits on the boundary (its best candidate is the centre, cost ~0); vertex 1 sits
+  // 2 mm outside it, so its boundary is inward. Its answer must not depend on vertex 0's
+  // costs (the minimum was once taken against the previous vertex's centre cost, which hid
+  // every inward candidate of vertex 1 behind vertex 0's near-perfect match).
+  Volume image = make_grid({32, 16, 16}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
+  fill_object(image, [](const Eigen::Vector3d& p) { return p.x() - 10.3; }, 1.0f, 0.0f, 5);
+  const VolumeSampler s(image);
+  RowMatrixX3d V(2, 3), N(2, 3);
+  V.row(0) = Eigen::RowVector3d(10.3, 6.0, 7.0);
+  V.row(1) = Eigen::RowVector3d(12.3, 8.0, 8.0);
+  N.row(0) = N.row(1) = Eigen::RowVector3d(1, 0, 0);
+  NormalSearchOptions o;
+  o.range_mm = 4;
+  o.step_mm = 0.5;
+  o.window_mm = 2;
+  const SearchResult r = search_step_edges(s, V, N, RegionStats{1.0, 0.0}, o);
+  EXPECT_NEAR(r.offsets[0], 0.0, 0.15);
+  EXPECT_NEAR(r.offsets[1], -2.0, 0.15);
+  RowMatrixX3d on = V;
+  on.col(0).setConstant(10.3);
+  const Eigen::MatrixXf learned = sample_profiles(s, on, N, 5, 1.0);
+  const SearchResult p = search_profiles(s, V, N, learned, 1.0, o);
+  EXPECT_NEAR(p.offsets[0], 0.0, 0.3);
+  EXPECT_NEAR(p.offsets[1], -2.0, 0.3);
+  // The same vertex alone gives the same answer.
+  const SearchResult alone = search_profiles(s, V.bottomRows(1), N.bottomRows(1), learned.bottomRows(1), 1.0, o);
+  EXPECT_DOUBLE_EQ(alone.offsets[0], p.offsets[1]);
+}
+
+TEST(Forces, MinGainKeepsAVertexInPlaceUnlessAMoveIsClearlyBetterOnEitherSide) {
+  // A clean step at x = 10.5 (between voxels, so the image is antisymmetric about it);
+  // vertex 0 sits 1 mm outside it, vertex 1 sits 1 mm inside it. By symmetry their best moves gain the
+  // same, so any min_gain moves both or neither.
+  Volume image = make_grid({32, 16, 16}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
+  fill_object(image, [](const Eigen::Vector3d& p) { return p.x() - 10.5; }, 1.0f, 0.0f, 5);
+  const VolumeSampler s(image);
+  RowMatrixX3d V(2, 3), N(2, 3);
+  V.row(0) = Eigen::RowVector3d(11.5, 6.0, 7.0);
+  V.row(1) = Eigen::RowVector3d(9.5, 8.0, 8.0);
+  N.row(0) = N.row(1) = Eigen::RowVector3d(1, 0, 0);
+  NormalSearchOptions o;
+  o.range_mm = 3;
+  o.step_mm = 0.5;
+  o.window_mm = 2;
+  o.distance_penalty = 0;
+  const SearchResult free_move = search_step_edges(s, V, N, RegionStats{1.0, 0.0}, o);
+  EXPECT_NEAR(free_move.offsets[0], -1.0, 0.15);
+  EXPECT_NEAR(free_move.offsets[1], 1.0, 0.15);
+  // The gain of the move: the centre's cost (seen from a vertex there) minus the best cost.
+  RowMatrixX3d centre_only = V;
+  NormalSearchOptions stay = o;
+  stay.range_mm = 0;  // a single candidate: the centre
+  const SearchResult at_centre = search_step_edges(s, centre_only, N, RegionStats{1.0, 0.0}, stay);
+  const double gain0 = at_centre.costs[0] - free_move.costs[0];
+  const double gain1 = at_centre.costs[1] - free_move.costs[1];
+  ASSERT_GT(gain0, 0.05);
+  EXPECT_NEAR(gain0, gain1, 1e-6);
+  // The distance penalty adds penalty·(t/range)² to a candidate at offset t, whichever side.
+  NormalSearchOptions penalized = o;
+  penalized.distance_penalty = 0.02;
+  const SearchResult pen = search_step_edges(s, V, N, RegionStats{1.0, 0.0}, penalized);
+  for (int v = 0; v < 2; ++v) {
+    // Same candidate; the sub-step refinement is pulled slightly towards staying.
+    EXPECT_LT(std::abs(pen.offsets[v]), std::abs(free_move.offsets[v]));
+    EXPECT_GT(pen.offsets[v] * free_move.offsets[v], 0.0);
+    EXPECT_NEAR(pen.offsets[v], free_move.offsets[v], 0.5 * o.step_mm);
+    EXPECT_NEAR(pen.costs[v] - free_move.costs[v], 0.02 * (1.0 / 3.0) * (1.0 / 3.0), 1e-9);
+  }
+  for (const double f : {0.5, 0.9, 1.1, 2.0}) {
+    o.min_gain = f * gain0;
+    const SearchResult r = search_step_edges(s, V, N, RegionStats{1.0, 0.0}, o);
+    if (f < 1) {
+      EXPECT_NEAR(r.offsets[0], -1.0, 0.15) << f;
+      EXPECT_NEAR(r.offsets[1], 1.0, 0.15) << f;
+    } else {  // stays: only the sub-step refinement around the centre, never a whole step
+      EXPECT_LE(std::abs(r.offsets[0]), 0.5 * o.step_mm) << f;
+      EXPECT_LE(std::abs(r.offsets[1]), 0.5 * o.step_mm) << f;
+      EXPECT_NEAR(r.offsets[0], -r.offsets[1], 1e-9) << f;
+    }
+  }
+}
+
 TEST(Appearance, SerializationRoundTripsAndRejectsDamage) {
   Appearance a;
   a.half_length = 2;
