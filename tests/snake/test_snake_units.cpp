@@ -452,22 +452,40 @@ TEST(Forces, StepEdgeAndProfileFindAPlaneBoundary) {
   EXPECT_NEAR(st.outside, 0.0, 0.2);
 }
 
+namespace {
+
+/// A clean step along x (1 below the boundary, 0 above, 32 x 16 x 16 voxels of 1 mm) and two
+/// vertices at x0 and x1 with normals +x, searched over +-range_mm in 0.5 mm steps.
+struct PlaneStepCase {
+  Volume image;
+  RowMatrixX3d V{2, 3}, N{2, 3};
+  NormalSearchOptions options;
+};
+
+PlaneStepCase plane_step_case(double boundary, double x0, double x1, double range_mm) {
+  PlaneStepCase c;
+  c.image = make_grid({32, 16, 16}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
+  fill_object(c.image, [boundary](const Eigen::Vector3d& p) { return p.x() - boundary; }, 1.0f, 0.0f, 5);
+  c.V.row(0) = Eigen::RowVector3d(x0, 6.0, 7.0);
+  c.V.row(1) = Eigen::RowVector3d(x1, 8.0, 8.0);
+  c.N.row(0) = c.N.row(1) = Eigen::RowVector3d(1, 0, 0);
+  c.options.range_mm = range_mm;
+  c.options.step_mm = 0.5;
+  c.options.window_mm = 2;
+  return c;
+}
+
+}  // namespace
+
 TEST(Forces, EachVertexFindsItsOwnBoundaryWhateverTheVertexBeforeIt) {
   // Vertex 0 sits on the boundary (its best candidate is the centre, cost ~0); vertex 1 sits
   // 2 mm outside it, so its boundary is inward. Its answer must not depend on vertex 0's
   // costs (the minimum was once taken against the previous vertex's centre cost, which hid
   // every inward candidate of vertex 1 behind vertex 0's near-perfect match).
-  Volume image = make_grid({32, 16, 16}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
-  fill_object(image, [](const Eigen::Vector3d& p) { return p.x() - 10.3; }, 1.0f, 0.0f, 5);
-  const VolumeSampler s(image);
-  RowMatrixX3d V(2, 3), N(2, 3);
-  V.row(0) = Eigen::RowVector3d(10.3, 6.0, 7.0);
-  V.row(1) = Eigen::RowVector3d(12.3, 8.0, 8.0);
-  N.row(0) = N.row(1) = Eigen::RowVector3d(1, 0, 0);
-  NormalSearchOptions o;
-  o.range_mm = 4;
-  o.step_mm = 0.5;
-  o.window_mm = 2;
+  const PlaneStepCase c = plane_step_case(10.3, 10.3, 12.3, 4);
+  const VolumeSampler s(c.image);
+  const RowMatrixX3d &V = c.V, &N = c.N;
+  const NormalSearchOptions o = c.options;
   const SearchResult r = search_step_edges(s, V, N, RegionStats{1.0, 0.0}, o);
   EXPECT_NEAR(r.offsets[0], 0.0, 0.15);
   EXPECT_NEAR(r.offsets[1], -2.0, 0.15);
@@ -486,17 +504,10 @@ TEST(Forces, MinGainKeepsAVertexInPlaceUnlessAMoveIsClearlyBetterOnEitherSide) {
   // A clean step at x = 10.5 (between voxels, so the image is antisymmetric about it);
   // vertex 0 sits 1 mm outside it, vertex 1 sits 1 mm inside it. By symmetry their best moves gain the
   // same, so any min_gain moves both or neither.
-  Volume image = make_grid({32, 16, 16}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
-  fill_object(image, [](const Eigen::Vector3d& p) { return p.x() - 10.5; }, 1.0f, 0.0f, 5);
-  const VolumeSampler s(image);
-  RowMatrixX3d V(2, 3), N(2, 3);
-  V.row(0) = Eigen::RowVector3d(11.5, 6.0, 7.0);
-  V.row(1) = Eigen::RowVector3d(9.5, 8.0, 8.0);
-  N.row(0) = N.row(1) = Eigen::RowVector3d(1, 0, 0);
-  NormalSearchOptions o;
-  o.range_mm = 3;
-  o.step_mm = 0.5;
-  o.window_mm = 2;
+  const PlaneStepCase c = plane_step_case(10.5, 11.5, 9.5, 3);
+  const VolumeSampler s(c.image);
+  const RowMatrixX3d &V = c.V, &N = c.N;
+  NormalSearchOptions o = c.options;
   o.distance_penalty = 0;
   const SearchResult free_move = search_step_edges(s, V, N, RegionStats{1.0, 0.0}, o);
   EXPECT_NEAR(free_move.offsets[0], -1.0, 0.15);
