@@ -25,7 +25,12 @@ struct LloydOptions {
   int iterations = 8;
   int first_movable = 0;        ///< vertices [0, first_movable) stay fixed (the paper's strict mode)
   double step = 1.0;            ///< fraction of the way to the centroid moved per iteration
-  int sample_budget = 400000;   ///< density samples per iteration over all faces (coarse levels integrate finely)
+  /// Density samples per iteration over all faces: a face gets about budget / faces of them
+  /// (at least the 3 corner-quadrilateral centroids). Coarse levels integrate finely; at the
+  /// fine levels a face spans few input faces and 3 samples suffice. 25k against 400k on the
+  /// 5 bench/remesh meshes and the liver: the same quality and distance to the input within
+  /// noise (RMS within 2 %), 40-60 % less remeshing time.
+  int sample_budget = 25000;
 };
 
 struct LloydStats {
