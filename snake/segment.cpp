@@ -275,15 +275,19 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     V = pose.apply(V);
   }
   // Start hypotheses for the fit: the pose found, and the same without its rotation about
-  // the centroid (principal axes can mislead on elongated or curved shapes).
-  std::vector<Similarity> starts{pose};
+  // the centroid (principal axes can mislead on elongated or curved shapes). After moments,
+  // the model's own pose too: a neighbour of the organ's intensity (the liver's kidney, the
+  // hippocampus' grey matter) drags the threshold's moments far off, while scans of a study
+  // are usually framed like the reference. The fit with the lowest search cost wins.
+  std::vector<std::pair<Similarity, std::string>> starts{{pose, to_string(init)}};
   if (!registered && pose.rotation_angle_deg() > 1.0) {
     const Eigen::Vector3d c = model.levels[0].colwise().mean().transpose();
     Similarity unrotated = pose;
     unrotated.rotation.setIdentity();
     unrotated.translation = pose.apply(c) - pose.scale * c;
-    starts.push_back(unrotated);
+    starts.emplace_back(unrotated, "moments without rotation");
   }
+  if (init == InitMode::moments_and_fit) starts.emplace_back(Similarity{}, "model pose");
   RegionStats stats;
   RowMatrixX3d N;
   const auto estimate_stats = [&](const RowMatrixX3d& W) {
@@ -311,7 +315,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     const auto [search, step] = search_for(jf, range_for(jf, options.coarse_range_edge_fraction, options.fit_min_range_voxels), stats);
     (void)step;
     double best_cost = std::numeric_limits<double>::infinity();
-    for (const Similarity& start : starts) {
+    for (const auto& [start, start_name] : starts) {
       RowMatrixX3d W = start.apply(model.levels[jf]);
       int iterations = 0;
       const Similarity fitted = fit_similarity_to_targets(W, model.faces(jf), search, options.fit, &iterations);
@@ -321,6 +325,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
         best_cost = cost;
         pose = fitted.compose(start);
         result.fit_iterations = iterations;
+        result.fit_start = start_name;
       }
     }
     V = pose.apply(model.levels[0]);
@@ -398,6 +403,7 @@ nlohmann::json segment_report(const SegmentResult& r) {
                        {"translation_mm", {r.initial_pose.translation.x(), r.initial_pose.translation.y(),
                                            r.initial_pose.translation.z()}},
                        {"fit_iterations", r.fit_iterations}};
+  if (!r.fit_start.empty()) j["initial_pose"]["fit_start"] = r.fit_start;
   j["init_used"] = to_string(r.init);
   if (r.registration) {
     const ReferenceRegistration& g = *r.registration;

@@ -229,6 +229,60 @@ TEST(Registration, RejectsAScaleOutsideItsRangeAndAnImageElsewhere) {
   EXPECT_NE(f.rejection.find("overlap"), std::string::npos) << f.rejection;
 }
 
+TEST(Initialization, MomentsFitAlsoTriesTheModelPose) {
+  // Bright slabs of the sphere's own intensity just beside it, inside the moments' region of
+  // interest: the threshold's moments land far off (shifted and scaled), while the model's
+  // own pose is right. moments+fit must keep the fit from the model's pose.
+  SynthOptions o;
+  o.shape = SynthShape::sphere;
+  o.size = {64, 64, 48};
+  o.snr = 8;
+  o.seed = 5;
+  SynthResult target = render_synth(draw_synth_params(o));
+  double inside = 0, outside = 0;
+  std::size_t n_in = 0, n_out = 0;
+  for (std::size_t v = 0; v < target.image.num_voxels(); ++v)
+    (target.truth.data[v] > 0 ? (inside += target.image.data[v], ++n_in) : (outside += target.image.data[v], ++n_out));
+  const double contrast = inside / n_in - outside / n_out;
+  const TriMesh ico = icosahedron();
+  const SubdivisionConnectivity conn = subdivide_connectivity(ico.F, 12, 2);
+  const Eigen::RowVector3d centre = target.truth_mesh.V.colwise().mean();
+  const RowMatrixX3d directions = test::sphere_directions(conn, ico.V);
+  double radius = 0;
+  for (int v = 0; v < target.truth_mesh.num_vertices(); ++v) radius += (target.truth_mesh.V.row(v) - centre).norm();
+  radius /= target.truth_mesh.num_vertices();
+  RowMatrixX3d finest = directions * radius;
+  finest.rowwise() += centre;
+  const SnakeModel model = midpoint_frame_model(conn, finest);
+  // Two slabs, 6 voxels thick, 2 voxels beyond the sphere along +x and along +y: an L that
+  // drags the moments' centre off the diagonal and turns their principal axes.
+  const auto c = target.image.physical_to_index({centre.x(), centre.y(), centre.z()});
+  const long r = std::lround(radius);
+  const long ci = std::lround(c[0]), cj = std::lround(c[1]), ck = std::lround(c[2]);
+  ASSERT_LT(ci + r + 8, static_cast<long>(o.size[0]));
+  ASSERT_LT(cj + r + 8, static_cast<long>(o.size[1]));
+  for (long k = ck - r; k <= ck + r; ++k)
+    for (long j = cj - r; j <= cj + r + 8; ++j)
+      for (long i = ci - r; i <= ci + r + 8; ++i)
+        if (i >= ci + r + 2 || j >= cj + r + 2) target.image.at(i, j, k) += static_cast<float>(contrast);
+  // The test's premise: the moments alone are far off.
+  const Similarity moments = moments_alignment(target.image, TriMesh{model.levels[1], model.faces(1)});
+  ASSERT_GT((moments.apply(Eigen::Vector3d(centre.transpose())) - centre.transpose()).norm(), 4.0);
+
+  SegmentOptions options;
+  options.force = ForceMode::step_edge;
+  options.init = InitMode::moments_and_fit;
+  options.count_self_intersections = false;
+  const SegmentResult result = segment(target.image, model, options);
+  EXPECT_EQ(result.fit_start, "model pose");
+  EXPECT_EQ(segment_report(result)["initial_pose"]["fit_start"], "model pose");
+  const Eigen::RowVector3d found = result.surface.V.colwise().mean();
+  EXPECT_LT((found - centre).norm(), 0.5);
+  double found_radius = 0;
+  for (int v = 0; v < result.surface.num_vertices(); ++v) found_radius += (result.surface.V.row(v) - found).norm();
+  EXPECT_NEAR(found_radius / result.surface.num_vertices(), radius, 0.5);
+}
+
 TEST(Registration, SegmentFallsBackToTheMomentsRouteAndSaysSo) {
   // A reference image that lies far from the new image: the registration is rejected,
   // segment takes moments+fit instead and its report says why.
