@@ -48,7 +48,7 @@ enum class InitMode {
   automatic,             ///< register+fit when the model has a reference image, else moments+fit (default)
   pose,                  ///< the model's physical pose as is
   moments,               ///< + moments of a rough threshold
-  moments_and_fit,       ///< + a similarity fit of the coarse mesh to its search targets
+  moments_and_fit,       ///< + a similarity fit of the coarse mesh to its search targets (also tried from the model's pose)
   fit,                   ///< the model's pose + the fit
   registration,          ///< + registration of the model's reference image to the image
   registration_and_fit,  ///< + the registration, then the fit
