@@ -156,8 +156,22 @@ int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh&
   // The snaps cost triangle quality: keep them only if they really bring the input closer
   // overall (the largest distance drops), not only around each snapped vertex.
   if (snaps > 0) {
-    const double largest_after = SurfaceLocator(TriMesh{X, F}).distances(surface_V).maxCoeff();
-    if (!(largest_after <= (1 - options.min_gain) * largest)) {
+    // Exactly "the largest distance after <= limit", without querying the whole input again:
+    // an input vertex whose nearest face did not change is at most as far as before (that
+    // face is still there), so only those nearest to a changed face and those that were
+    // already beyond the limit can be beyond it now.
+    const double limit = (1 - options.min_gain) * largest;
+    std::vector<bool> changed(m, false);
+    for (int v = 0; v < n; ++v)
+      if (moved[v])
+        for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) changed[stars.faces[i]] = true;
+    std::vector<int> recheck;
+    for (int s = 0; s < input_vertices; ++s)
+      if (changed[nearest_face[s]] || distance[s] > limit) recheck.push_back(s);
+    RowMatrixX3d points(static_cast<Eigen::Index>(recheck.size()), 3);
+    for (std::size_t i = 0; i < recheck.size(); ++i) points.row(static_cast<Eigen::Index>(i)) = surface_V.row(recheck[i]);
+    const double largest_after = recheck.empty() ? 0.0 : SurfaceLocator(TriMesh{X, F}).distances(points).maxCoeff();
+    if (!(largest_after <= limit)) {
       U = U_before;
       X = X_before;
       hints = hints_before;
