@@ -13,6 +13,7 @@
 #include "apps/report/remesh_page.h"
 #include "mesh/atomic_file.h"
 #include "mesh/distance.h"
+#include "mesh/errors.h"
 #include "mesh/image_io.h"
 #include "mesh/marching_cubes.h"
 #include "mesh/quality.h"
@@ -100,6 +101,15 @@ void add_build_model_command(CLI::App& app) {
     mc.max_closing_radius = a->close_tunnels;
     mc.resample_spacing_mm = mc_spacing;
     const LabelSurface surface = extract_label_surface(labels, a->label, mc, progress);
+    // Say how to repair it here, where the flag is known, not after the costly part.
+    if (surface.genus_before_repair > 0 && surface.closing_radius == 0)
+      throw TopologyError(
+          "label " + std::to_string(a->label) + " has a genus-" + std::to_string(surface.genus_before_repair) +
+          " surface (tunnels through it), but a model needs genus 0; " +
+          (a->close_tunnels > 0 ? "closing tunnels up to " + std::to_string(a->close_tunnels) +
+                                      " voxels wide did not remove them: try a larger --close-tunnels"
+                                : std::string("add --close-tunnels 3 to close tunnels up to 3 voxels wide")) +
+          ", or fill them in the label volume");
     if (!surface.dropped_component_faces.empty())
       warn("label " + std::to_string(a->label) + " has " + std::to_string(surface.components_found) +
            " connected surfaces; the model uses the largest");

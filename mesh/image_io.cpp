@@ -16,6 +16,7 @@
 
 #include <zlib.h>
 
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <vector>
@@ -84,17 +85,71 @@ void check_gzip_complete(const std::string& path) {
                      "); re-export or re-copy the file");
 }
 
-bool file_extension_is_plain(const std::string& path) {
-  return path.size() < 3 || path.compare(path.size() - 3, 3, ".gz") != 0;
+// The header lines of a MetaImage ("Key = Value", up to ElementDataFile) or NRRD ("key: value",
+// up to the first blank line) file, keys lower-cased without spaces.
+std::vector<std::pair<std::string, std::string>> header_fields(const std::string& path, char separator) {
+  std::vector<std::pair<std::string, std::string>> fields;
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  for (int n = 0; n < 200 && std::getline(in, line); ++n) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) break;  // NRRD: the data follows
+    const auto at = line.find(separator);
+    if (at == std::string::npos) continue;
+    std::string key, value = line.substr(at + 1);
+    for (char c : line.substr(0, at))
+      if (!std::isspace(static_cast<unsigned char>(c))) key += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    value.erase(0, value.find_first_not_of(" \t"));
+    value.erase(value.find_last_not_of(" \t") + 1);
+    fields.emplace_back(key, value);
+    if (key == "elementdatafile") break;  // MetaImage: the data follows
+  }
+  return fields;
 }
 
-// An uncompressed image must hold all of its voxels (ITK zero-fills a short file too).
+// The file that holds an image's voxels uncompressed, when that is known: the image file
+// itself (NIfTI, GIPL, a MetaImage or NRRD with its data inline), or the raw data file a
+// .mhd or detached .nhdr names. Empty when the voxels are compressed or split over files:
+// no size check is possible then (zlib reports a damaged stream itself).
+std::string raw_voxel_file(const std::string& path) {
+  const std::string extension = std::filesystem::path(path).extension().string();
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  const auto lower = [](std::string text) {
+    for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return text;
+  };
+  if (extension == ".mha" || extension == ".mhd") {
+    std::string data_file;
+    for (const auto& [key, value] : header_fields(path, '=')) {
+      if (key == "compresseddata" && lower(value) == "true") return "";
+      if (key == "elementdatafile") data_file = value;
+    }
+    if (data_file.empty() || lower(data_file) == "list" || data_file.find('%') != std::string::npos) return "";
+    return lower(data_file) == "local" ? path : (folder / data_file).string();
+  }
+  if (extension == ".nrrd" || extension == ".nhdr") {
+    std::string data_file;
+    for (const auto& [key, value] : header_fields(path, ':')) {
+      if (key == "encoding" && lower(value) != "raw") return "";
+      if (key == "datafile") data_file = value;
+    }
+    if (data_file.empty()) return extension == ".nrrd" ? path : "";
+    if (data_file.find(' ') != std::string::npos || lower(data_file).rfind("list", 0) == 0) return "";
+    return (folder / data_file).string();
+  }
+  if (extension == ".nii" || extension == ".gipl") return path;
+  return "";
+}
+
+// Uncompressed voxels must all be there: ITK zero-fills a short file.
 void check_size(const std::string& path, const itk::ImageIOBase* io) {
+  const std::string data_file = raw_voxel_file(path);
+  if (data_file.empty()) return;
   std::error_code ec;
-  const auto bytes = std::filesystem::file_size(path, ec);
-  if (ec || io->GetFileName() != path) return;  // data in a separate file (e.g. .mhd + .raw)
+  const auto bytes = std::filesystem::file_size(data_file, ec);
+  if (ec) throw InputError("'" + path + "' names the voxel file '" + data_file + "', which cannot be read; copy it beside the header");
   if (bytes < static_cast<std::uintmax_t>(io->GetImageSizeInBytes()))
-    throw InputError("'" + path + "' is truncated: it holds " + std::to_string(bytes) + " bytes for " +
+    throw InputError("'" + data_file + "' is truncated: it holds " + std::to_string(bytes) + " bytes for " +
                      std::to_string(io->GetImageSizeInBytes()) + " bytes of voxels");
 }
 
@@ -135,7 +190,7 @@ Volume read_volume(const std::string& path) {
     if (io->GetNumberOfComponents() != 1)
       throw InputError("'" + path + "' has " + std::to_string(io->GetNumberOfComponents()) +
                        " components per voxel; mrsnake needs a scalar image");
-    if (file_extension_is_plain(path)) check_size(path, io);
+    check_size(path, io);
     auto reader = itk::ImageFileReader<FloatImage>::New();
     reader->SetFileName(path);
     reader->SetImageIO(io);

@@ -12,6 +12,7 @@
 #include <limits>
 
 #include <nlohmann/json.hpp>
+#include <zlib.h>
 
 #include "mesh/image_io.h"
 #include "tests/test_support.h"
@@ -124,6 +125,45 @@ TEST_F(Robustness, EmptyLabelVolume) {
   expect_one_line_error(run_mrsnake("build-model --labels " + path("empty.nii.gz") + " --label 1 -o " + path("e.model")),
                         3, "not present");
   EXPECT_FALSE(fs::exists(path("e.model")));
+}
+
+TEST_F(Robustness, MetaImageWithItsVoxelsInAnotherFile) {
+  // .mhd headers name their voxel file (raw, or zlib-compressed .zraw, as VTK's frog data);
+  // the size check must look at that file, not at the header.
+  std::vector<unsigned char> voxels(20 * 20 * 20, 0);
+  for (int k = 0; k < 20; ++k)
+    for (int j = 0; j < 20; ++j)
+      for (int i = 0; i < 20; ++i)
+        if ((i - 9.5) * (i - 9.5) + (j - 9.5) * (j - 9.5) + (k - 9.5) * (k - 9.5) <= 36) voxels[i + 20 * (j + 20 * k)] = 1;
+  const auto write_header = [&](const std::string& name, const std::string& data_file, std::size_t compressed_bytes) {
+    std::ofstream h(path(name));
+    h << "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\n";
+    if (compressed_bytes > 0) h << "CompressedData = True\nCompressedDataSize = " << compressed_bytes << "\n";
+    h << "ElementSpacing = 1 1 1.5\nDimSize = 20 20 20\nElementType = MET_UCHAR\nElementDataFile = " << data_file << "\n";
+  };
+  const auto write_bytes = [&](const std::string& name, const unsigned char* data, std::size_t n) {
+    std::ofstream(path(name), std::ios::binary).write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(n));
+  };
+  write_bytes("ball.raw", voxels.data(), voxels.size());
+  write_header("ball.mhd", "ball.raw", 0);
+  std::vector<unsigned char> packed(compressBound(voxels.size()));
+  uLongf packed_size = packed.size();
+  ASSERT_EQ(compress2(packed.data(), &packed_size, voxels.data(), voxels.size(), 6), Z_OK);
+  write_bytes("ball.zraw", packed.data(), packed_size);
+  write_header("ballz.mhd", "ball.zraw", packed_size);
+  for (const std::string name : {"ball", "ballz"}) {
+    const auto r = run_mrsnake("-q mc --labels " + path(name + ".mhd") + " --label 1 -o " + path(name + ".vtp"));
+    EXPECT_EQ(r.exit_code, 0) << name << ": " << r.output;
+  }
+  write_bytes("short.raw", voxels.data(), voxels.size() / 2);
+  write_header("short.mhd", "short.raw", 0);
+  expect_one_line_error(run_mrsnake("mc --labels " + path("short.mhd") + " --label 1 -o " + path("s.vtp")), 3,
+                        "short.raw' is truncated");
+  write_header("orphan.mhd", "gone.raw", 0);
+  expect_one_line_error(run_mrsnake("mc --labels " + path("orphan.mhd") + " --label 1 -o " + path("o.vtp")), 3,
+                        "gone.raw");
+  EXPECT_FALSE(fs::exists(path("s.vtp")));
+  EXPECT_FALSE(fs::exists(path("o.vtp")));
 }
 
 TEST_F(Robustness, NanAndInfVoxelsAreIgnored) {

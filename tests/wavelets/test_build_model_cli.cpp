@@ -133,8 +133,17 @@ TEST(BuildModelCli, CloseTunnelsMakesAGenusOneLabelModelable) {
   write_volume(labels, v, VoxelType::uint8);
   const std::string model = (dir / "torus.model").string();
 
+  // Refused before the remeshing, with the flag that repairs it.
   const auto refused = run_mrsnake("-q build-model --labels " + labels + " --label 4 -o " + model + " --faces 2048");
-  EXPECT_NE(refused.exit_code, 0) << refused.output;
+  EXPECT_EQ(refused.exit_code, 3) << refused.output;
+  EXPECT_NE(refused.output.find("genus-1 surface (tunnels through it), but a model needs genus 0; add --close-tunnels 3"),
+            std::string::npos)
+      << refused.output;
+  EXPECT_FALSE(std::filesystem::exists(model));
+  const auto too_small =
+      run_mrsnake("-q build-model --labels " + labels + " --label 4 -o " + model + " --faces 2048 --close-tunnels 1");
+  EXPECT_EQ(too_small.exit_code, 3) << too_small.output;
+  EXPECT_NE(too_small.output.find("try a larger --close-tunnels"), std::string::npos) << too_small.output;
   EXPECT_FALSE(std::filesystem::exists(model));
 
   const auto built =
