@@ -28,8 +28,8 @@ struct LloydOptions {
   /// Density samples per iteration over all faces: a face gets about budget / faces of them
   /// (at least the 3 corner-quadrilateral centroids). Coarse levels integrate finely; at the
   /// fine levels a face spans few input faces and 3 samples suffice. 25k against 400k on the
-  /// 5 bench/remesh meshes and the liver: the same quality and distance to the input within
-  /// noise (RMS within 2 %), 40-60 % less remeshing time.
+  /// 5 bench/remesh meshes and the liver: RMS within 2 %, Q min within ±0.05 (either way),
+  /// 40-60 % less remeshing time (docs/bench-remesh.md).
   int sample_budget = 25000;
 };
 
