@@ -106,9 +106,9 @@ void add_build_model_command(CLI::App& app) {
       throw TopologyError(
           "label " + std::to_string(a->label) + " has a genus-" + std::to_string(surface.genus_before_repair) +
           " surface (tunnels through it), but a model needs genus 0; " +
-          (a->close_tunnels > 0 ? "closing tunnels up to " + std::to_string(a->close_tunnels) +
-                                      " voxels wide did not remove them: try a larger --close-tunnels"
-                                : std::string("add --close-tunnels 3 to close tunnels up to 3 voxels wide")) +
+          (a->close_tunnels > 0 ? "a closing of radius up to " + std::to_string(a->close_tunnels) +
+                                      " voxels did not remove them: try a larger --close-tunnels"
+                                : std::string("add --close-tunnels 3 (a morphological closing of radius up to 3 voxels)")) +
           ", or fill them in the label volume");
     if (!surface.dropped_component_faces.empty())
       warn("label " + std::to_string(a->label) + " has " + std::to_string(surface.components_found) +

@@ -8,9 +8,9 @@
 // mrsnake runs as a subprocess through its command-line contract
 //   mrsnake remesh INPUT -o DIR --faces N [--no-relax]  ->  DIR/level_0.vtp ... level_L.vtp, report.json
 // (wall time of the whole command and the child's peak RSS from wait4), and the level whose
-// face count is nearest N is measured. The speed ratio compares like with like: mrsnake's
-// own remeshing time (report.json's "seconds") against CGAL's call; the ratio to the whole
-// command is printed too. CGAL runs in this process (10 iterations, constraints
+// face count is nearest N is measured. The speed ratio compares the remeshing alone:
+// mrsnake's own time (report.json's "seconds", wall, its Lloyd and lifting loops on up to 2
+// threads) against CGAL's call (one thread); the ratio to the whole command is printed too. CGAL runs in this process (10 iterations, constraints
 // not protected) with a target edge length from the equilateral estimate, corrected once,
 // aimed at the face count of mrsnake's measured level (at N if mrsnake has none); its peak RSS is the process's high-water mark during the call (reset before it).
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -635,7 +635,8 @@ int main(int argc, char** argv) {
               "val6%% = interior vertices of valence 6; RMS%%, Haus%% = symmetric distance to the input in %% of\n"
               "its bounding-box diagonal (%d samples per face + vertices); selfX = pairs of intersecting faces;\n"
               "cpu_s = user + system time; algo_s = the remeshing alone, wall (mrsnake: report.json's seconds,\n"
-              "without reading, writing and the report's distance statistics; CGAL: its call);\n"
+              "without reading, writing and the report's distance statistics, on up to 2 threads; CGAL: its\n"
+              "call, one thread);\n"
               "speed = CGAL's algo_s / algo_s (> 1 is faster than CGAL); cmd_sp = CGAL's call / the whole mrsnake\n"
               "command, wall (the JSON also has the CPU ratio of the whole command).\n\n",
               o.samples);

@@ -112,19 +112,21 @@ std::vector<std::pair<std::string, std::string>> header_fields(const std::string
 // .mhd or detached .nhdr names. Empty when the voxels are compressed or split over files:
 // no size check is possible then (zlib reports a damaged stream itself).
 std::string raw_voxel_file(const std::string& path) {
-  const std::string extension = std::filesystem::path(path).extension().string();
-  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
   const auto lower = [](std::string text) {
     for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return text;
   };
+  const std::string extension = lower(std::filesystem::path(path).extension().string());
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
   if (extension == ".mha" || extension == ".mhd") {
     std::string data_file;
     for (const auto& [key, value] : header_fields(path, '=')) {
-      if (key == "compresseddata" && lower(value) == "true") return "";
+      // MetaIO reads a value starting with T, t or 1 as true.
+      if (key == "compresseddata" && !value.empty() && (value[0] == 'T' || value[0] == 't' || value[0] == '1')) return "";
       if (key == "elementdatafile") data_file = value;
     }
-    if (data_file.empty() || lower(data_file) == "list" || data_file.find('%') != std::string::npos) return "";
+    // "LIST [2D]" and printf-style patterns spread the voxels over several files.
+    if (data_file.empty() || lower(data_file).rfind("list", 0) == 0 || data_file.find('%') != std::string::npos) return "";
     return lower(data_file) == "local" ? path : (folder / data_file).string();
   }
   if (extension == ".nrrd" || extension == ".nhdr") {
@@ -141,13 +143,33 @@ std::string raw_voxel_file(const std::string& path) {
   return "";
 }
 
+// The first line of an ITK error, without its "itk::ERROR: Class(0x...): " prefix: the
+// messages must stay one line.
+std::string first_line_of_itk_error(const std::string& description) {
+  std::string line = description.substr(0, description.find('\n'));
+  const std::string tag = "itk::ERROR: ";
+  if (line.rfind(tag, 0) == 0) {
+    const auto end = line.find("): ");
+    line = end == std::string::npos ? line.substr(tag.size()) : line.substr(end + 3);
+  }
+  while (!line.empty() && (line.back() == ':' || line.back() == ' ' || line.back() == '\r')) line.pop_back();
+  return line;
+}
+
+// A header's separate voxel file must exist (checked before ITK reads the header: its NRRD
+// reader fails with a multi-line dump).
+void check_voxel_file_exists(const std::string& path, const std::string& data_file) {
+  std::error_code ec;
+  if (!data_file.empty() && data_file != path && !std::filesystem::is_regular_file(data_file, ec))
+    throw InputError("'" + path + "' names the voxel file '" + data_file + "', which is missing; copy it beside the header");
+}
+
 // Uncompressed voxels must all be there: ITK zero-fills a short file.
-void check_size(const std::string& path, const itk::ImageIOBase* io) {
-  const std::string data_file = raw_voxel_file(path);
+void check_size(const std::string& data_file, const itk::ImageIOBase* io) {
   if (data_file.empty()) return;
   std::error_code ec;
   const auto bytes = std::filesystem::file_size(data_file, ec);
-  if (ec) throw InputError("'" + path + "' names the voxel file '" + data_file + "', which cannot be read; copy it beside the header");
+  if (ec) return;  // not a regular file (a pipe): ITK's reader will tell
   if (bytes < static_cast<std::uintmax_t>(io->GetImageSizeInBytes()))
     throw InputError("'" + data_file + "' is truncated: it holds " + std::to_string(bytes) + " bytes for " +
                      std::to_string(io->GetImageSizeInBytes()) + " bytes of voxels");
@@ -175,6 +197,8 @@ Volume read_volume(const std::string& path) {
   try {
     if (std::filesystem::is_directory(path, ec)) return read_dicom_series(path);
     check_gzip_complete(path);
+    const std::string data_file = raw_voxel_file(path);
+    check_voxel_file_exists(path, data_file);
     auto io = itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::ImageIOFactory::IOFileModeEnum::ReadMode);
     if (!io) throw InputError("'" + path + "' is not an image format mrsnake reads (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)");
     io->SetFileName(path);
@@ -190,14 +214,14 @@ Volume read_volume(const std::string& path) {
     if (io->GetNumberOfComponents() != 1)
       throw InputError("'" + path + "' has " + std::to_string(io->GetNumberOfComponents()) +
                        " components per voxel; mrsnake needs a scalar image");
-    check_size(path, io);
+    check_size(data_file, io);
     auto reader = itk::ImageFileReader<FloatImage>::New();
     reader->SetFileName(path);
     reader->SetImageIO(io);
     reader->Update();
     return to_volume(reader->GetOutput(), path);
   } catch (const itk::ExceptionObject& e) {
-    throw InputError("cannot read image '" + path + "': " + std::string(e.GetDescription()) +
+    throw InputError("cannot read image '" + path + "': " + first_line_of_itk_error(e.GetDescription()) +
                      "; the file may be corrupt or truncated");
   }
 }

@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "mesh/vertex_stars.h"
+
 namespace mrsnake {
 namespace {
 
@@ -81,25 +83,18 @@ std::vector<bool> boundary_vertices(const RowMatrixX3i& F, int num_vertices) {
 }
 
 DomainMesh::DomainMesh(RowMatrixX3d D, RowMatrixX3i F) : D_(std::move(D)), F_(std::move(F)) {
-  // Directed edges a->b bucketed by a (counting sort, in face order): a vertex has a handful,
-  // so finding b->a is a short scan, 5x faster than sorting 64-bit keys on a 179k-face liver.
-  // A repeated directed edge resolves to its last face, as a map filled in face order would.
+  // The face holding the directed edge tail -> head: in tail's star (5x faster than sorting
+  // 64-bit edge keys on a 179k-face liver). A repeated directed edge resolves to its last
+  // face, as a map filled in face order would.
   const int m = static_cast<int>(F_.rows());
-  const int n = static_cast<int>(std::max<Eigen::Index>(D_.rows(), m > 0 ? F_.maxCoeff() + 1 : 0));
-  std::vector<int> offset(n + 1, 0);
-  for (int f = 0; f < m; ++f)
-    for (int e = 0; e < 3; ++e) ++offset[F_(f, e) + 1];
-  for (int v = 0; v < n; ++v) offset[v + 1] += offset[v];
-  std::vector<std::pair<int, int>> outgoing(offset[n]);  // (head, face), grouped by tail
-  {
-    std::vector<int> fill(offset.begin(), offset.end() - 1);
-    for (int f = 0; f < m; ++f)
-      for (int e = 0; e < 3; ++e) outgoing[fill[F_(f, e)]++] = {F_(f, (e + 1) % 3), f};
-  }
+  const VertexStars stars(F_, static_cast<int>(std::max<Eigen::Index>(D_.rows(), m > 0 ? F_.maxCoeff() + 1 : 0)));
   const auto face_of = [&](int tail, int head) {
     int face = -1;
-    for (int i = offset[tail]; i < offset[tail + 1]; ++i)
-      if (outgoing[i].first == head) face = outgoing[i].second;
+    for (int i = stars.offset[tail]; i < stars.offset[tail + 1]; ++i) {
+      const int f = stars.faces[i];
+      for (int k = 0; k < 3; ++k)
+        if (F_(f, k) == tail && F_(f, (k + 1) % 3) == head) face = f;
+    }
     return face;
   };
   edge_normal_.resize(F_.rows(), 9);

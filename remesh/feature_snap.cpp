@@ -156,7 +156,8 @@ int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh&
   // The snaps cost triangle quality: keep them only if they really bring the input closer
   // overall (the largest distance drops), not only around each snapped vertex.
   if (snaps > 0) {
-    // Exactly "the largest distance after <= limit", without querying the whole input again:
+    // "The largest distance after <= limit" (the same decision as querying the whole input,
+    // up to rounding), without querying the whole input again:
     // an input vertex whose nearest face did not change is at most as far as before (that
     // face is still there), so only those nearest to a changed face and those that were
     // already beyond the limit can be beyond it now.

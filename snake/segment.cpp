@@ -278,8 +278,11 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   // the centroid (principal axes can mislead on elongated or curved shapes). After moments,
   // the model's own pose too: a neighbour of the organ's intensity (the liver's kidney, the
   // hippocampus' grey matter) drags the threshold's moments far off, while scans of a study
-  // are usually framed like the reference. The fit with the lowest search cost wins.
-  std::vector<std::pair<Similarity, std::string>> starts{{pose, to_string(init)}};
+  // are usually framed like the reference. The fit with the lowest search cost wins (every
+  // start is scored with the same statistics).
+  const bool from_moments = init == InitMode::moments || init == InitMode::moments_and_fit;
+  std::vector<std::pair<Similarity, std::string>> starts{
+      {pose, registered ? "registration" : from_moments ? "moments" : "model pose"}};
   if (!registered && pose.rotation_angle_deg() > 1.0) {
     const Eigen::Vector3d c = model.levels[0].colwise().mean().transpose();
     Similarity unrotated = pose;
@@ -287,7 +290,12 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     unrotated.translation = pose.apply(c) - pose.scale * c;
     starts.emplace_back(unrotated, "moments without rotation");
   }
-  if (init == InitMode::moments_and_fit) starts.emplace_back(Similarity{}, "model pose");
+  if (init == InitMode::moments_and_fit) {
+    const Eigen::Vector3d c = model.levels[0].colwise().mean().transpose();
+    const bool at_model_pose = pose.rotation_angle_deg() < 1.0 && std::abs(pose.scale - 1.0) < 0.01 &&
+                               (pose.apply(c) - c).norm() < spacings[0];
+    if (!at_model_pose) starts.emplace_back(Similarity{}, "model pose");
+  }
   RegionStats stats;
   RowMatrixX3d N;
   const auto estimate_stats = [&](const RowMatrixX3d& W) {

@@ -131,8 +131,8 @@ struct SegmentResult {
   InitMode init = InitMode::pose;  ///< the route taken (auto resolved, after any fallback)
   std::optional<ReferenceRegistration> registration;  ///< when a registration route was asked for
   int fit_iterations = 0;
-  /// The start the fit kept (the route's pose, "moments without rotation" or "model
-  /// pose"); empty without a fit.
+  /// The start the fit kept: "registration", "moments", "moments without rotation" or
+  /// "model pose"; empty without a fit.
   std::string fit_start;
   RegionStats region;
   IntensityWindow window;

@@ -128,8 +128,9 @@ TEST_F(Robustness, EmptyLabelVolume) {
 }
 
 TEST_F(Robustness, MetaImageWithItsVoxelsInAnotherFile) {
-  // .mhd headers name their voxel file (raw, or zlib-compressed .zraw, as VTK's frog data);
-  // the size check must look at that file, not at the header.
+  // .mhd and .nhdr headers name their voxel file (raw, or compressed: .zraw as VTK's frog
+  // data, gzip-encoded NRRD); the size check must look at that file, not at the header, and
+  // leave compressed voxels to zlib.
   std::vector<unsigned char> voxels(20 * 20 * 20, 0);
   for (int k = 0; k < 20; ++k)
     for (int j = 0; j < 20; ++j)
@@ -164,6 +165,31 @@ TEST_F(Robustness, MetaImageWithItsVoxelsInAnotherFile) {
                         "gone.raw");
   EXPECT_FALSE(fs::exists(path("s.vtp")));
   EXPECT_FALSE(fs::exists(path("o.vtp")));
+
+  // The same for NRRD: a detached header (.nhdr) naming its raw file, and gzip encoding.
+  const auto write_nhdr = [&](const std::string& name, const std::string& data_file) {
+    std::ofstream(path(name)) << "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 20 20 20\nspacings: 1 1 1.5\n"
+                                 "encoding: raw\ndata file: " << data_file << "\n\n";
+  };
+  write_nhdr("ball.nhdr", "ball.raw");
+  const auto nhdr = run_mrsnake("-q mc --labels " + path("ball.nhdr") + " --label 1 -o " + path("nhdr.vtp"));
+  EXPECT_EQ(nhdr.exit_code, 0) << nhdr.output;
+  write_nhdr("short.nhdr", "short.raw");
+  expect_one_line_error(run_mrsnake("mc --labels " + path("short.nhdr") + " --label 1 -o " + path("sn.vtp")), 3,
+                        "short.raw' is truncated");
+  write_nhdr("orphan.nhdr", "gone.raw");
+  expect_one_line_error(run_mrsnake("mc --labels " + path("orphan.nhdr") + " --label 1 -o " + path("on.vtp")), 3,
+                        "gone.raw");
+  mrsnake::Volume ball;
+  ball.size = {20, 20, 20};
+  ball.data.assign(voxels.begin(), voxels.end());
+  mrsnake::write_volume(path("ball.nrrd"), ball, mrsnake::VoxelType::uint8);  // gzip-encoded
+  std::ifstream written(path("ball.nrrd"), std::ios::binary);
+  const std::string nrrd((std::istreambuf_iterator<char>(written)), std::istreambuf_iterator<char>());
+  ASSERT_NE(nrrd.find("encoding: gzip"), std::string::npos);
+  ASSERT_LT(nrrd.size(), voxels.size());  // smaller than its voxels: a size check would refuse it
+  const auto gz = run_mrsnake("-q mc --labels " + path("ball.nrrd") + " --label 1 -o " + path("nrrd.vtp"));
+  EXPECT_EQ(gz.exit_code, 0) << gz.output;
 }
 
 TEST_F(Robustness, NanAndInfVoxelsAreIgnored) {

@@ -136,10 +136,11 @@ TEST(BuildModelCli, CloseTunnelsMakesAGenusOneLabelModelable) {
   // Refused before the remeshing, with the flag that repairs it.
   const auto refused = run_mrsnake("-q build-model --labels " + labels + " --label 4 -o " + model + " --faces 2048");
   EXPECT_EQ(refused.exit_code, 3) << refused.output;
-  EXPECT_NE(refused.output.find("genus-1 surface (tunnels through it), but a model needs genus 0; add --close-tunnels 3"),
+  EXPECT_NE(refused.output.find("genus-1 surface (tunnels through it), but a model needs genus 0; add --close-tunnels 3 "),
             std::string::npos)
       << refused.output;
   EXPECT_FALSE(std::filesystem::exists(model));
+  // Too small a radius leaves the tunnel open: still refused, with a hint.
   const auto too_small =
       run_mrsnake("-q build-model --labels " + labels + " --label 4 -o " + model + " --faces 2048 --close-tunnels 1");
   EXPECT_EQ(too_small.exit_code, 3) << too_small.output;
@@ -156,9 +157,4 @@ TEST(BuildModelCli, CloseTunnelsMakesAGenusOneLabelModelable) {
   EXPECT_LE(summary["closing_radius_voxels"].get<int>(), 6);
   const ShapeModel m = load_model(model, {true});
   EXPECT_EQ(m.levels(), summary["levels"].get<int>());
-
-  // Too small a radius leaves the tunnel open, and the build still refuses it.
-  EXPECT_NE(run_mrsnake("-q build-model --labels " + labels + " --label 4 -o " + model + "-r1 --faces 2048 --close-tunnels 1")
-                .exit_code,
-            0);
 }
