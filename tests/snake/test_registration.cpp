@@ -85,6 +85,37 @@ Eigen::Vector3d apply_pose(const SimilarityParams& p, const Eigen::Vector3d& x) 
 using test::read_all;
 using test::write_all;
 
+/// A synthetic sphere (SNR 8) and a model of it: an icosahedron subdivided twice, of the given
+/// radius (<= 0: the truth's mean radius) at the truth's centre, without lifting.
+struct SphereCase {
+  SynthResult target;
+  Eigen::RowVector3d centre;
+  double radius = 0;
+  RowMatrixX3d finest;
+  SnakeModel model;
+};
+SphereCase sphere_case(const std::array<int, 3>& size, int seed, double radius) {
+  SynthOptions o;
+  o.shape = SynthShape::sphere;
+  o.size = size;
+  o.snr = 8;
+  o.seed = seed;
+  SphereCase c;
+  c.target = render_synth(draw_synth_params(o));
+  c.centre = c.target.truth_mesh.V.colwise().mean();
+  c.radius = radius;
+  if (c.radius <= 0) {
+    for (int v = 0; v < c.target.truth_mesh.num_vertices(); ++v) c.radius += (c.target.truth_mesh.V.row(v) - c.centre).norm();
+    c.radius /= c.target.truth_mesh.num_vertices();
+  }
+  const TriMesh ico = icosahedron();
+  const SubdivisionConnectivity conn = subdivide_connectivity(ico.F, 12, 2);
+  c.finest = test::sphere_directions(conn, ico.V) * c.radius;
+  c.finest.rowwise() += c.centre;
+  c.model = midpoint_frame_model(conn, c.finest);
+  return c;
+}
+
 }  // namespace
 
 struct PoseErrors {
@@ -233,34 +264,23 @@ TEST(Initialization, MomentsFitAlsoTriesTheModelPose) {
   // Bright slabs of the sphere's own intensity just beside it, inside the moments' region of
   // interest: the threshold's moments land far off (shifted and scaled), while the model's
   // own pose is right. moments+fit must keep the fit from the model's pose.
-  SynthOptions o;
-  o.shape = SynthShape::sphere;
-  o.size = {64, 64, 48};
-  o.snr = 8;
-  o.seed = 5;
-  SynthResult target = render_synth(draw_synth_params(o));
+  SphereCase sc = sphere_case({64, 64, 48}, 5, 0);
+  SynthResult& target = sc.target;
+  const Eigen::RowVector3d centre = sc.centre;
+  const double radius = sc.radius;
+  const SnakeModel& model = sc.model;
   double inside = 0, outside = 0;
   std::size_t n_in = 0, n_out = 0;
   for (std::size_t v = 0; v < target.image.num_voxels(); ++v)
     (target.truth.data[v] > 0 ? (inside += target.image.data[v], ++n_in) : (outside += target.image.data[v], ++n_out));
   const double contrast = inside / n_in - outside / n_out;
-  const TriMesh ico = icosahedron();
-  const SubdivisionConnectivity conn = subdivide_connectivity(ico.F, 12, 2);
-  const Eigen::RowVector3d centre = target.truth_mesh.V.colwise().mean();
-  const RowMatrixX3d directions = test::sphere_directions(conn, ico.V);
-  double radius = 0;
-  for (int v = 0; v < target.truth_mesh.num_vertices(); ++v) radius += (target.truth_mesh.V.row(v) - centre).norm();
-  radius /= target.truth_mesh.num_vertices();
-  RowMatrixX3d finest = directions * radius;
-  finest.rowwise() += centre;
-  const SnakeModel model = midpoint_frame_model(conn, finest);
   // Two slabs, 6 voxels thick, 2 voxels beyond the sphere along +x and along +y: an L that
   // drags the moments' centre off the diagonal and turns their principal axes.
   const auto c = target.image.physical_to_index({centre.x(), centre.y(), centre.z()});
   const long r = std::lround(radius);
   const long ci = std::lround(c[0]), cj = std::lround(c[1]), ck = std::lround(c[2]);
-  ASSERT_LT(ci + r + 8, static_cast<long>(o.size[0]));
-  ASSERT_LT(cj + r + 8, static_cast<long>(o.size[1]));
+  ASSERT_LT(ci + r + 8, static_cast<long>(target.image.size[0]));
+  ASSERT_LT(cj + r + 8, static_cast<long>(target.image.size[1]));
   for (long k = ck - r; k <= ck + r; ++k)
     for (long j = cj - r; j <= cj + r + 8; ++j)
       for (long i = ci - r; i <= ci + r + 8; ++i)
@@ -289,19 +309,10 @@ TEST(Initialization, MomentsFitAlsoTriesTheModelPose) {
 TEST(Registration, SegmentFallsBackToTheMomentsRouteAndSaysSo) {
   // A reference image that lies far from the new image: the registration is rejected,
   // segment takes moments+fit instead and its report says why.
-  SynthOptions o;
-  o.shape = SynthShape::sphere;
-  o.size = {48, 48, 48};
-  o.snr = 8;
-  o.seed = 3;
-  const SynthResult target = render_synth(draw_synth_params(o));
-  const TriMesh ico = icosahedron();
-  const SubdivisionConnectivity conn = subdivide_connectivity(ico.F, 12, 2);
-  const Eigen::RowVector3d centre = target.truth_mesh.V.colwise().mean();
-  RowMatrixX3d finest = test::sphere_directions(conn, ico.V) * 12.0;
-  finest.rowwise() += centre;
-  SnakeModel model = midpoint_frame_model(conn, finest);
-  Volume reference = reference_crop(target.image, finest);
+  SphereCase sc = sphere_case({48, 48, 48}, 3, 12.0);
+  const SynthResult& target = sc.target;
+  SnakeModel& model = sc.model;
+  Volume reference = reference_crop(target.image, sc.finest);
   reference.origin[2] += 1000.0;
   model.reference_image = reference;
   SegmentOptions options;
