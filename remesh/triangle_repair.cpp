@@ -68,6 +68,17 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
   stats.q_min_before = smallest_q();
   std::vector<std::pair<double, int>> poor;
   std::vector<int> visited(n, -1);
+  // A vertex's attempt depends only on its 1-ring's positions: after a failed attempt it is
+  // tried again only once something in its 1-ring has moved (same result, fewer attempts).
+  long clock = 0;
+  std::vector<long> moved_at(n, -1), failed_at(n, -1);
+  const auto ring_moved_since = [&](int v, long time) {
+    if (moved_at[v] > time) return true;
+    for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i)
+      for (int k = 0; k < 3; ++k)
+        if (moved_at[F(stars.faces[i], k)] > time) return true;
+    return false;
+  };
   for (int sweep = 0; sweep < options.sweeps; ++sweep) {
     poor.clear();
     for (int f = 0; f < m; ++f)
@@ -81,6 +92,8 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
         if (visited[v] == sweep || (boundary[v] && !options.move_rim)) continue;
         if (options.fixed && (*options.fixed)[v]) continue;
         visited[v] = sweep;
+        if (failed_at[v] >= 0 && !ring_moved_since(v, failed_at[v])) continue;
+        failed_at[v] = ++clock;  // cleared below if v moves
         const Eigen::Vector3d x = X.row(v);
         const double current = star_quality(X, F, stars, v, x);
         if (!(current < options.threshold)) continue;
@@ -111,8 +124,8 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
         const std::optional<TrianglePullback> pullback = TrianglePullback::of(surface_V, PD, PF, hints[v]);
         if (!pullback) continue;
         const Eigen::Vector3d u = U.row(v);
-        const double allowed_error =
-            options.guard_surface_error ? std::max(surface_error(v, u, x, x), options.error_tolerance * mean_edge) : 0.0;
+        // The guard's allowance, computed when a candidate first needs it.
+        double allowed_error = -1;
         double best = current;
         Eigen::Vector3d best_u = u, best_x = x;
         int best_hint = hints[v];
@@ -127,7 +140,10 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
             const Eigen::Vector3d lifted = lift(candidate, hint);
             const double q = star_quality(X, F, stars, v, lifted);
             if (!(q > best + 1e-9)) continue;
-            if (options.guard_surface_error && surface_error(v, candidate, lifted, x) > allowed_error) continue;
+            if (options.guard_surface_error) {
+              if (allowed_error < 0) allowed_error = std::max(surface_error(v, u, x, x), options.error_tolerance * mean_edge);
+              if (surface_error(v, candidate, lifted, x) > allowed_error) continue;
+            }
             best = q;
             best_u = candidate;
             best_x = lifted;
@@ -138,6 +154,8 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
         U.row(v) = best_u.transpose();
         X.row(v) = best_x.transpose();
         hints[v] = best_hint;
+        failed_at[v] = -1;
+        moved_at[v] = ++clock;
         ++moved;
       }
     stats.moves += moved;
