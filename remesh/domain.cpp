@@ -2,9 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <limits>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -13,8 +11,16 @@
 namespace mrsnake {
 namespace {
 
-std::uint64_t directed_key(int a, int b) {
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
+// The last face (in face order) holding the directed edge tail -> head, or -1: a scan of
+// tail's star.
+int face_with_directed_edge(const VertexStars& stars, const RowMatrixX3i& F, int tail, int head) {
+  int face = -1;
+  for (int i = stars.offset[tail]; i < stars.offset[tail + 1]; ++i) {
+    const int f = stars.faces[i];
+    for (int k = 0; k < 3; ++k)
+      if (F(f, k) == tail && F(f, (k + 1) % 3) == head) face = f;
+  }
+  return face;
 }
 
 // Nearest point of triangle (a, b, c) to p, as barycentric coordinates (Ericson's method).
@@ -68,17 +74,20 @@ int count_flipped(const RowMatrixX3d& D, const RowMatrixX3i& F) {
   return flipped;
 }
 
-std::vector<bool> boundary_vertices(const RowMatrixX3i& F, int num_vertices) {
-  std::unordered_map<std::uint64_t, int> directed;
-  directed.reserve(3 * F.rows());
-  for (int f = 0; f < F.rows(); ++f)
-    for (int e = 0; e < 3; ++e) directed[directed_key(F(f, e), F(f, (e + 1) % 3))] = f;
-  std::vector<bool> boundary(num_vertices, false);
+std::vector<std::pair<int, int>> boundary_edges(const RowMatrixX3i& F, int num_vertices) {
+  const VertexStars stars(F, num_vertices);
+  std::vector<std::pair<int, int>> edges;
   for (int f = 0; f < F.rows(); ++f)
     for (int e = 0; e < 3; ++e) {
       const int a = F(f, e), b = F(f, (e + 1) % 3);
-      if (!directed.count(directed_key(b, a))) boundary[a] = boundary[b] = true;
+      if (face_with_directed_edge(stars, F, b, a) < 0) edges.emplace_back(a, b);
     }
+  return edges;
+}
+
+std::vector<bool> boundary_vertices(const RowMatrixX3i& F, int num_vertices) {
+  std::vector<bool> boundary(num_vertices, false);
+  for (const auto& [a, b] : boundary_edges(F, num_vertices)) boundary[a] = boundary[b] = true;
   return boundary;
 }
 
@@ -88,15 +97,6 @@ DomainMesh::DomainMesh(RowMatrixX3d D, RowMatrixX3i F) : D_(std::move(D)), F_(st
   // face, as a map filled in face order would.
   const int m = static_cast<int>(F_.rows());
   const VertexStars stars(F_, static_cast<int>(std::max<Eigen::Index>(D_.rows(), m > 0 ? F_.maxCoeff() + 1 : 0)));
-  const auto face_of = [&](int tail, int head) {
-    int face = -1;
-    for (int i = stars.offset[tail]; i < stars.offset[tail + 1]; ++i) {
-      const int f = stars.faces[i];
-      for (int k = 0; k < 3; ++k)
-        if (F_(f, k) == tail && F_(f, (k + 1) % 3) == head) face = f;
-    }
-    return face;
-  };
   edge_normal_.resize(F_.rows(), 9);
   for (int f = 0; f < F_.rows(); ++f) {
     const Eigen::Vector3d a = D_.row(F_(f, 0)), b = D_.row(F_(f, 1)), c = D_.row(F_(f, 2));
@@ -109,7 +109,7 @@ DomainMesh::DomainMesh(RowMatrixX3d D, RowMatrixX3i F) : D_(std::move(D)), F_(st
     for (int corner = 0; corner < 3; ++corner) {
       // The edge opposite `corner` runs from corner+1 to corner+2.
       const int a = F_(f, (corner + 1) % 3), b = F_(f, (corner + 2) % 3);
-      neighbor_(f, corner) = face_of(b, a);
+      neighbor_(f, corner) = face_with_directed_edge(stars, F_, b, a);
     }
 }
 

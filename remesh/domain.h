@@ -6,6 +6,7 @@
 /// sphere a point is a unit vector; in the unit disk the point (x, y) is stored as (x, y, 1).
 /// In both cases det(a, b, c) > 0 means the triangle (a, b, c) is counter-clockwise seen from
 /// outside (sphere) or from +z (disk).
+#include <utility>
 #include <vector>
 
 #include "mesh/trimesh.h"
@@ -26,7 +27,13 @@ Eigen::Vector3d project_to_domain(DomainKind kind, const Eigen::Vector3d& p, boo
 /// Number of faces of (D, F) with domain_orientation <= 0.
 int count_flipped(const RowMatrixX3d& D, const RowMatrixX3i& F);
 
+/// The directed edges a -> b of F, in face order, with no face running b -> a: the boundary,
+/// each edge with its face on the left.
+/// \pre every entry of F is in [0, num_vertices).
+std::vector<std::pair<int, int>> boundary_edges(const RowMatrixX3i& F, int num_vertices);
+
 /// Vertices on a boundary edge (an edge used by one face).
+/// \pre every entry of F is in [0, num_vertices).
 std::vector<bool> boundary_vertices(const RowMatrixX3i& F, int num_vertices);
 
 /// A triangulation embedded in D (the parameterized input), with walking point location.

@@ -2,9 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <optional>
-#include <unordered_set>
 
 #include <Eigen/Dense>
 
@@ -17,21 +15,11 @@ namespace {
 // For each disk rim vertex, its two rim neighbours (previous and next along the boundary);
 // -1 elsewhere.
 std::vector<Eigen::Vector2i> rim_neighbours(const RowMatrixX3i& F, int n) {
-  auto key = [](int a, int b) {
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
-  };
-  std::unordered_set<std::uint64_t> directed;
-  directed.reserve(3 * F.rows());
-  for (int f = 0; f < F.rows(); ++f)
-    for (int e = 0; e < 3; ++e) directed.insert(key(F(f, e), F(f, (e + 1) % 3)));
   std::vector<Eigen::Vector2i> rim(n, Eigen::Vector2i(-1, -1));
-  for (int f = 0; f < F.rows(); ++f)
-    for (int e = 0; e < 3; ++e) {
-      const int a = F(f, e), b = F(f, (e + 1) % 3);
-      if (directed.count(key(b, a))) continue;
-      rim[a][1] = b;  // a -> b runs along the boundary
-      rim[b][0] = a;
-    }
+  for (const auto& [a, b] : boundary_edges(F, n)) {
+    rim[a][1] = b;  // a -> b runs along the boundary
+    rim[b][0] = a;
+  }
   return rim;
 }
 
