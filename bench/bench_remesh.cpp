@@ -3,7 +3,7 @@
 // same run: time, peak memory, faces, regularity, triangle quality and distance to the input.
 //
 //   bench_remesh [--data DIR] [--mrsnake PATH] [--inputs a,b,...] [--targets 16000,32000]
-//                [--out DIR] [--samples N] [--iterations N] [--timeout SECONDS]
+//                [--out DIR] [--samples N] [--iterations N] [--timeout SECONDS] [--repeat N]
 //
 // mrsnake runs as a subprocess through its command-line contract
 //   mrsnake remesh INPUT -o DIR --faces N [--no-relax]  ->  DIR/level_0.vtp ... level_L.vtp, report.json
@@ -69,7 +69,15 @@ struct Options {
   int samples = 10;
   int iterations = 10;
   double timeout = 1800;
+  int repeat = 3;  ///< timed runs per method and case; the medians are reported
 };
+
+double median(std::vector<double> values) {
+  if (values.empty()) return std::nan("");
+  std::sort(values.begin(), values.end());
+  const std::size_t h = values.size() / 2;
+  return values.size() % 2 ? values[h] : 0.5 * (values[h - 1] + values[h]);
+}
 
 std::vector<std::string> split_list(const std::string& s) {
   std::vector<std::string> items;
@@ -95,7 +103,7 @@ int parse_count(std::string s) {
   if (!error.empty()) std::cerr << "bench_remesh: " << error << "\n";
   std::cerr << "usage: bench_remesh [--data DIR] [--mrsnake PATH] [--inputs mushroom,heart,...,liver]\n"
                "                    [--targets 16000,32000] [--out DIR] [--samples N] [--iterations N]\n"
-               "                    [--timeout SECONDS]\n"
+               "                    [--timeout SECONDS] [--repeat N]\n"
                "  --data DIR        shared data folder (default $MRSNAKE_DATA, else ../shared/data)\n"
                "  --mrsnake PATH    the mrsnake binary (default: the one built beside this benchmark)\n"
                "  --inputs LIST     names under DIR/meshes (.off), 'liver' (from mrsnake mc), or mesh paths\n"
@@ -103,7 +111,8 @@ int parse_count(std::string s) {
                "  --out DIR         working folder; bench_remesh.json is written there\n"
                "  --samples N       random points per face for the surface distance (default 10)\n"
                "  --iterations N    CGAL isotropic_remeshing iterations (default 10)\n"
-               "  --timeout S       per mrsnake run (default 1800)\n";
+               "  --timeout S       per mrsnake run (default 1800)\n"
+               "  --repeat N        timed runs of each method per case; medians are reported (default 3)\n";
   std::exit(error.empty() ? 0 : 2);
 }
 
@@ -128,6 +137,7 @@ Options parse_options(int argc, char** argv) {
       else if (arg == "--samples") o.samples = std::stoi(value());
       else if (arg == "--iterations") o.iterations = std::stoi(value());
       else if (arg == "--timeout") o.timeout = std::stod(value());
+      else if (arg == "--repeat") o.repeat = std::stoi(value());
       else if (arg == "-h" || arg == "--help") usage("");
       else usage("unknown option " + arg);
     } catch (const std::invalid_argument& e) {
@@ -137,7 +147,8 @@ Options parse_options(int argc, char** argv) {
     }
   }
   if (o.inputs.empty() || o.targets.empty()) usage("--inputs and --targets need at least one entry");
-  if (o.samples < 0 || o.iterations < 1 || o.timeout <= 0) usage("--samples, --iterations, --timeout must be positive");
+  if (o.samples < 0 || o.iterations < 1 || o.timeout <= 0 || o.repeat < 1)
+    usage("--samples, --iterations, --timeout, --repeat must be positive");
   return o;
 }
 
@@ -314,11 +325,20 @@ CgalRun cgal_remesh_once(const TriMesh& input, double edge_length, int iteration
 
 /// Equilateral estimate: F faces of edge e cover F·(√3/4)e², so e = sqrt(4A/(√3·F)); one
 /// correction by the face count the first run gave (faces scale as 1/e²).
-CgalRun cgal_remesh(const TriMesh& input, int target_faces, int iterations) {
+CgalRun cgal_remesh(const TriMesh& input, int target_faces, int iterations, int repeat) {
   const double e0 = std::sqrt(4.0 * total_area(input) / (std::sqrt(3.0) * target_faces));
   const CgalRun probe = cgal_remesh_once(input, e0, iterations);
   const double e1 = e0 * std::sqrt(static_cast<double>(probe.mesh.num_faces()) / target_faces);
   CgalRun r = cgal_remesh_once(input, e1, iterations);
+  // The same call again (CGAL is deterministic) for the median time.
+  std::vector<double> seconds{r.seconds}, cpu_seconds{r.cpu_seconds};
+  for (int run = 1; run < repeat; ++run) {
+    const CgalRun again = cgal_remesh_once(input, e1, iterations);
+    seconds.push_back(again.seconds);
+    cpu_seconds.push_back(again.cpu_seconds);
+  }
+  r.seconds = median(seconds);
+  r.cpu_seconds = median(cpu_seconds);
   r.probe_edge_length = e0;
   r.probe_faces = probe.mesh.num_faces();
   r.probe_seconds = probe.seconds;
@@ -398,18 +418,32 @@ Row run_mrsnake_remesh(const Options& o, const std::string& name, const std::str
                                    std::to_string(target)};
   if (!relax) args.push_back("--no-relax");
   const std::string log = (dir / "mrsnake.log").string();
-  const ChildRun child = run_child(args, log, o.timeout);
-  row.seconds = child.seconds;
-  row.cpu_seconds = child.cpu_seconds;
-  row.peak_mib = child.peak_mib;
-  if (child.timed_out) {
-    row.status = "timed out after " + std::to_string(static_cast<int>(o.timeout)) + " s";
-    return row;
+  // The output is deterministic: every run writes the same levels; the timings are medians.
+  std::vector<double> seconds, cpu_seconds, algorithm_seconds;
+  for (int run = 0; run < o.repeat; ++run) {
+    const ChildRun child = run_child(args, log, o.timeout);
+    if (child.timed_out) {
+      row.status = "timed out after " + std::to_string(static_cast<int>(o.timeout)) + " s";
+      return row;
+    }
+    if (child.exit_code != 0) {
+      row.status = "exit " + std::to_string(child.exit_code) + ": " + last_line_of(log);
+      return row;
+    }
+    seconds.push_back(child.seconds);
+    cpu_seconds.push_back(child.cpu_seconds);
+    row.peak_mib = std::max(row.peak_mib, child.peak_mib);
+    try {
+      std::ifstream in(dir / "report.json");
+      if (const auto a = internal_seconds(json::parse(in))) algorithm_seconds.push_back(*a);
+    } catch (const std::exception& e) {
+      row.extra["report_error"] = e.what();
+    }
   }
-  if (child.exit_code != 0) {
-    row.status = "exit " + std::to_string(child.exit_code) + ": " + last_line_of(log);
-    return row;
-  }
+  row.seconds = median(seconds);
+  row.cpu_seconds = median(cpu_seconds);
+  if (!algorithm_seconds.empty()) row.algorithm_seconds = median(algorithm_seconds);
+  row.extra["runs"] = o.repeat;
   // The level nearest the target face count.
   int best_faces = -1;
   TriMesh best;
@@ -429,18 +463,8 @@ Row run_mrsnake_remesh(const Options& o, const std::string& name, const std::str
   }
   measure(row, best, input, o.samples);
   row.extra["levels_dir"] = dir.string();
-  const fs::path report_path = dir / "report.json";
-  if (fs::exists(report_path)) {
-    try {
-      std::ifstream in(report_path);
-      const json report = json::parse(in);
-      if (const auto s = internal_seconds(report)) row.algorithm_seconds = *s;
-    } catch (const std::exception& e) {
-      row.extra["report_error"] = e.what();
-    }
-  } else {
-    row.extra["report_error"] = "report.json missing";
-  }
+  if (std::isnan(row.algorithm_seconds) && !row.extra.contains("report_error"))
+    row.extra["report_error"] = "report.json missing or without seconds";
   return row;
 }
 
@@ -452,7 +476,7 @@ Row run_cgal(const Options& o, const std::string& name, const TriMesh& input, in
   row.target = target;
   row.method = "cgal-isotropic";
   try {
-    const CgalRun r = cgal_remesh(input, faces, o.iterations);
+    const CgalRun r = cgal_remesh(input, faces, o.iterations, o.repeat);
     row.seconds = r.seconds;
     row.cpu_seconds = r.cpu_seconds;
     row.peak_mib = r.peak_mib;
@@ -638,8 +662,9 @@ int main(int argc, char** argv) {
               "without reading, writing and the report's distance statistics, on up to 2 threads; CGAL: its\n"
               "call, one thread);\n"
               "speed = CGAL's algo_s / algo_s (> 1 is faster than CGAL); cmd_sp = CGAL's call / the whole mrsnake\n"
-              "command, wall (the JSON also has the CPU ratio of the whole command).\n\n",
-              o.samples);
+              "command, wall (the JSON also has the CPU ratio of the whole command).\n"
+              "Times are medians of %d runs of each method.\n\n",
+              o.samples, o.repeat);
   print_header();
   for (const Row& r : rows) print_row(r);
 
@@ -648,6 +673,7 @@ int main(int argc, char** argv) {
             {"mrsnake_remesh_available", remesh_available},
             {"cgal_version", CGAL_VERSION_STR},
             {"cgal_iterations", o.iterations},
+            {"timed_runs", o.repeat},
             {"samples_per_face", o.samples},
             {"hardware_threads", std::thread::hardware_concurrency()},
             {"inputs", inputs_json},
