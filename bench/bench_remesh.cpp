@@ -9,8 +9,9 @@
 //   mrsnake remesh INPUT -o DIR --faces N [--no-relax]  ->  DIR/level_0.vtp ... level_L.vtp, report.json
 // (wall time of the whole command and the child's peak RSS from wait4), and the level whose
 // face count is nearest N is measured. The speed ratio compares the remeshing alone:
-// mrsnake's own time (report.json's "seconds", wall, its Lloyd and lifting loops on up to 2
-// threads) against CGAL's call (one thread); the ratio to the whole command is printed too. CGAL runs in this process (10 iterations, constraints
+// mrsnake's own time (report.json's "seconds", wall; its parallel loops use the machine's
+// threads, at most 8) against CGAL's call (one thread); the ratio to the whole command is
+// printed too. Each time is the median of --repeat runs. CGAL runs in this process (10 iterations, constraints
 // not protected) with a target edge length from the equilateral estimate, corrected once,
 // aimed at the face count of mrsnake's measured level (at N if mrsnake has none); its peak RSS is the process's high-water mark during the call (reset before it).
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -336,6 +337,7 @@ CgalRun cgal_remesh(const TriMesh& input, int target_faces, int iterations, int 
     const CgalRun again = cgal_remesh_once(input, e1, iterations);
     seconds.push_back(again.seconds);
     cpu_seconds.push_back(again.cpu_seconds);
+    r.peak_mib = std::max(r.peak_mib, again.peak_mib);
   }
   r.seconds = median(seconds);
   r.cpu_seconds = median(cpu_seconds);
@@ -421,6 +423,7 @@ Row run_mrsnake_remesh(const Options& o, const std::string& name, const std::str
   // The output is deterministic: every run writes the same levels; the timings are medians.
   std::vector<double> seconds, cpu_seconds, algorithm_seconds;
   for (int run = 0; run < o.repeat; ++run) {
+    fs::remove(dir / "report.json");  // each run's own, or none
     const ChildRun child = run_child(args, log, o.timeout);
     if (child.timed_out) {
       row.status = "timed out after " + std::to_string(static_cast<int>(o.timeout)) + " s";
@@ -433,6 +436,10 @@ Row run_mrsnake_remesh(const Options& o, const std::string& name, const std::str
     seconds.push_back(child.seconds);
     cpu_seconds.push_back(child.cpu_seconds);
     row.peak_mib = std::max(row.peak_mib, child.peak_mib);
+    if (!fs::exists(dir / "report.json")) {
+      row.extra["report_error"] = "report.json missing";
+      continue;
+    }
     try {
       std::ifstream in(dir / "report.json");
       if (const auto a = internal_seconds(json::parse(in))) algorithm_seconds.push_back(*a);
@@ -440,6 +447,7 @@ Row run_mrsnake_remesh(const Options& o, const std::string& name, const std::str
       row.extra["report_error"] = e.what();
     }
   }
+  row.extra["algorithm_runs"] = algorithm_seconds.size();
   row.seconds = median(seconds);
   row.cpu_seconds = median(cpu_seconds);
   if (!algorithm_seconds.empty()) row.algorithm_seconds = median(algorithm_seconds);
@@ -464,7 +472,7 @@ Row run_mrsnake_remesh(const Options& o, const std::string& name, const std::str
   measure(row, best, input, o.samples);
   row.extra["levels_dir"] = dir.string();
   if (std::isnan(row.algorithm_seconds) && !row.extra.contains("report_error"))
-    row.extra["report_error"] = "report.json missing or without seconds";
+    row.extra["report_error"] = "report.json without seconds";
   return row;
 }
 
@@ -659,12 +667,12 @@ int main(int argc, char** argv) {
               "val6%% = interior vertices of valence 6; RMS%%, Haus%% = symmetric distance to the input in %% of\n"
               "its bounding-box diagonal (%d samples per face + vertices); selfX = pairs of intersecting faces;\n"
               "cpu_s = user + system time; algo_s = the remeshing alone, wall (mrsnake: report.json's seconds,\n"
-              "without reading, writing and the report's distance statistics, on up to 2 threads; CGAL: its\n"
-              "call, one thread);\n"
+              "without reading, writing and the report's distance statistics; its parallel loops use up to %u\n"
+              "threads here; CGAL: its call, one thread);\n"
               "speed = CGAL's algo_s / algo_s (> 1 is faster than CGAL); cmd_sp = CGAL's call / the whole mrsnake\n"
               "command, wall (the JSON also has the CPU ratio of the whole command).\n"
-              "Times are medians of %d runs of each method.\n\n",
-              o.samples, o.repeat);
+              "Times are medians of %d runs of each method, peak memory the largest of them.\n\n",
+              o.samples, std::min(8u, std::max(1u, std::thread::hardware_concurrency())), o.repeat);
   print_header();
   for (const Row& r : rows) print_row(r);
 

@@ -107,11 +107,16 @@ std::vector<std::pair<std::string, std::string>> header_fields(const std::string
   return fields;
 }
 
-// The file that holds an image's voxels uncompressed, when that is known: the image file
-// itself (NIfTI, GIPL, a MetaImage or NRRD with its data inline), or the raw data file a
-// .mhd or detached .nhdr names. Empty when the voxels are compressed or split over files:
-// no size check is possible then (zlib reports a damaged stream itself).
-std::string raw_voxel_file(const std::string& path) {
+// Where an image's voxels are: the image file itself (NIfTI, GIPL, a MetaImage or NRRD with
+// its data inline) or the data file a .mhd or detached .nhdr names, and whether they are
+// stored raw (so that the file must hold all of them). An empty file when they are spread over
+// several files or the format is not known here.
+struct VoxelFile {
+  std::string path;
+  bool raw = false;
+};
+
+VoxelFile voxel_file(const std::string& path) {
   const auto lower = [](std::string text) {
     for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return text;
@@ -120,58 +125,75 @@ std::string raw_voxel_file(const std::string& path) {
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
   if (extension == ".mha" || extension == ".mhd") {
     std::string data_file;
+    bool compressed = false;
     for (const auto& [key, value] : header_fields(path, '=')) {
       // MetaIO reads a value starting with T, t or 1 as true.
-      if (key == "compresseddata" && !value.empty() && (value[0] == 'T' || value[0] == 't' || value[0] == '1')) return "";
+      if (key == "compresseddata") compressed = !value.empty() && (value[0] == 'T' || value[0] == 't' || value[0] == '1');
       if (key == "elementdatafile") data_file = value;
     }
     // "LIST [2D]" and printf-style patterns spread the voxels over several files.
-    if (data_file.empty() || lower(data_file).rfind("list", 0) == 0 || data_file.find('%') != std::string::npos) return "";
-    return lower(data_file) == "local" ? path : (folder / data_file).string();
+    if (data_file.empty() || lower(data_file).rfind("list", 0) == 0 || data_file.find('%') != std::string::npos) return {};
+    return {lower(data_file) == "local" ? path : (folder / data_file).string(), !compressed};
   }
   if (extension == ".nrrd" || extension == ".nhdr") {
     std::string data_file;
+    bool raw = true;
     for (const auto& [key, value] : header_fields(path, ':')) {
-      if (key == "encoding" && lower(value) != "raw") return "";
+      if (key == "encoding") raw = lower(value) == "raw";
       if (key == "datafile") data_file = value;
     }
-    if (data_file.empty()) return extension == ".nrrd" ? path : "";
-    if (data_file.find(' ') != std::string::npos || lower(data_file).rfind("list", 0) == 0) return "";
-    return (folder / data_file).string();
+    if (data_file.empty()) return extension == ".nrrd" ? VoxelFile{path, raw} : VoxelFile{};
+    if (data_file.find(' ') != std::string::npos || lower(data_file).rfind("list", 0) == 0) return {};
+    return {(folder / data_file).string(), raw};
   }
-  if (extension == ".nii" || extension == ".gipl") return path;
-  return "";
+  if (extension == ".nii" || extension == ".gipl") return {path, true};
+  return {};
 }
 
-// The first line of an ITK error, without its "itk::ERROR: Class(0x...): " prefix: the
-// messages must stay one line.
-std::string first_line_of_itk_error(const std::string& description) {
-  std::string line = description.substr(0, description.find('\n'));
-  const std::string tag = "itk::ERROR: ";
-  if (line.rfind(tag, 0) == 0) {
-    const auto end = line.find("): ");
-    line = end == std::string::npos ? line.substr(tag.size()) : line.substr(end + 3);
+// An ITK error as one line: without its "ITK ERROR: Class(0x...): " prefix, and with the
+// lines of a multi-line reason (teem's NRRD trace) joined, the innermost last.
+std::string one_line_itk_error(const std::string& description) {
+  std::string out;
+  std::size_t start = 0;
+  while (start <= description.size()) {
+    const std::size_t end = std::min(description.find('\n', start), description.size());
+    std::string line = description.substr(start, end - start);
+    start = end + 1;
+    for (const std::string tag : {"ITK ERROR: ", "itk::ERROR: "})
+      if (line.rfind(tag, 0) == 0) {
+        line = line.substr(tag.size());
+        const auto close = line.find("): ");
+        if (line.find('(') != std::string::npos && close != std::string::npos && line.find(' ') > line.find('('))
+          line = line.substr(close + 3);  // the "Class(0x...)" token
+      }
+    while (!line.empty() && (line.back() == ':' || line.back() == ' ' || line.back() == '\r')) line.pop_back();
+    while (!line.empty() && line.front() == ' ') line.erase(0, 1);
+    if (line.empty()) continue;
+    out += (out.empty() ? "" : "; ") + line;
   }
-  while (!line.empty() && (line.back() == ':' || line.back() == ' ' || line.back() == '\r')) line.pop_back();
-  return line;
+  return out;
 }
 
-// A header's separate voxel file must exist (checked before ITK reads the header: its NRRD
+// A header's separate voxel file must be there (checked before ITK reads the header: its NRRD
 // reader fails with a multi-line dump).
-void check_voxel_file_exists(const std::string& path, const std::string& data_file) {
+void check_voxel_file_exists(const std::string& path, const VoxelFile& voxels) {
   std::error_code ec;
-  if (!data_file.empty() && data_file != path && !std::filesystem::is_regular_file(data_file, ec))
-    throw InputError("'" + path + "' names the voxel file '" + data_file + "', which is missing; copy it beside the header");
+  if (voxels.path.empty() || voxels.path == path) return;
+  if (!std::filesystem::exists(voxels.path, ec))
+    throw InputError("'" + path + "' names the voxel file '" + voxels.path + "', which is missing; copy it beside the header");
+  if (!std::filesystem::is_regular_file(voxels.path, ec))
+    throw InputError("'" + path + "' names the voxel file '" + voxels.path + "', which is not a regular file");
 }
 
-// Uncompressed voxels must all be there: ITK zero-fills a short file.
-void check_size(const std::string& data_file, const itk::ImageIOBase* io) {
-  if (data_file.empty()) return;
+// Raw voxels must all be there: ITK zero-fills a short file. (Compressed ones are left to
+// zlib, which reports a damaged stream itself.)
+void check_size(const VoxelFile& voxels, const itk::ImageIOBase* io) {
+  if (voxels.path.empty() || !voxels.raw) return;
   std::error_code ec;
-  const auto bytes = std::filesystem::file_size(data_file, ec);
+  const auto bytes = std::filesystem::file_size(voxels.path, ec);
   if (ec) return;  // not a regular file (a pipe): ITK's reader will tell
   if (bytes < static_cast<std::uintmax_t>(io->GetImageSizeInBytes()))
-    throw InputError("'" + data_file + "' is truncated: it holds " + std::to_string(bytes) + " bytes for " +
+    throw InputError("'" + voxels.path + "' is truncated: it holds " + std::to_string(bytes) + " bytes for " +
                      std::to_string(io->GetImageSizeInBytes()) + " bytes of voxels");
 }
 
@@ -197,8 +219,8 @@ Volume read_volume(const std::string& path) {
   try {
     if (std::filesystem::is_directory(path, ec)) return read_dicom_series(path);
     check_gzip_complete(path);
-    const std::string data_file = raw_voxel_file(path);
-    check_voxel_file_exists(path, data_file);
+    const VoxelFile voxels = voxel_file(path);
+    check_voxel_file_exists(path, voxels);
     auto io = itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::ImageIOFactory::IOFileModeEnum::ReadMode);
     if (!io) throw InputError("'" + path + "' is not an image format mrsnake reads (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)");
     io->SetFileName(path);
@@ -214,14 +236,14 @@ Volume read_volume(const std::string& path) {
     if (io->GetNumberOfComponents() != 1)
       throw InputError("'" + path + "' has " + std::to_string(io->GetNumberOfComponents()) +
                        " components per voxel; mrsnake needs a scalar image");
-    check_size(data_file, io);
+    check_size(voxels, io);
     auto reader = itk::ImageFileReader<FloatImage>::New();
     reader->SetFileName(path);
     reader->SetImageIO(io);
     reader->Update();
     return to_volume(reader->GetOutput(), path);
   } catch (const itk::ExceptionObject& e) {
-    throw InputError("cannot read image '" + path + "': " + first_line_of_itk_error(e.GetDescription()) +
+    throw InputError("cannot read image '" + path + "': " + one_line_itk_error(e.GetDescription()) +
                      "; the file may be corrupt or truncated");
   }
 }

@@ -14,9 +14,9 @@ namespace {
 
 // For each disk rim vertex, its two rim neighbours (previous and next along the boundary);
 // -1 elsewhere.
-std::vector<Eigen::Vector2i> rim_neighbours(const RowMatrixX3i& F, int n) {
+std::vector<Eigen::Vector2i> rim_neighbours(const std::vector<std::pair<int, int>>& rim_edges, int n) {
   std::vector<Eigen::Vector2i> rim(n, Eigen::Vector2i(-1, -1));
-  for (const auto& [a, b] : boundary_edges(F, n)) {
+  for (const auto& [a, b] : rim_edges) {
     rim[a][1] = b;  // a -> b runs along the boundary
     rim[b][0] = a;
   }
@@ -29,10 +29,12 @@ int smooth_shapes_in_domain(DomainKind kind, const RowMatrixX3i& F, const Domain
                             const RowMatrixX3d& surface_V, RowMatrixX3d& U, RowMatrixX3d& X,
                             std::vector<int>& hints, const ShapeSmoothingOptions& options) {
   const int n = static_cast<int>(U.rows());
-  const std::vector<bool> boundary = kind == DomainKind::disk ? boundary_vertices(F, n) : std::vector<bool>(n, false);
-  const std::vector<Eigen::Vector2i> rim = kind == DomainKind::disk && options.move_rim
-                                               ? rim_neighbours(F, n)
-                                               : std::vector<Eigen::Vector2i>();
+  const std::vector<std::pair<int, int>> rim_edges =
+      kind == DomainKind::disk ? boundary_edges(F, n) : std::vector<std::pair<int, int>>();
+  std::vector<bool> boundary(n, false);
+  for (const auto& [a, b] : rim_edges) boundary[a] = boundary[b] = true;
+  const std::vector<Eigen::Vector2i> rim =
+      kind == DomainKind::disk && options.move_rim ? rim_neighbours(rim_edges, n) : std::vector<Eigen::Vector2i>();
   const VertexStars stars(F, n);
   const auto& PF = param.faces();
   const auto& PD = param.positions();

@@ -290,12 +290,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     unrotated.translation = pose.apply(c) - pose.scale * c;
     starts.emplace_back(unrotated, "moments without rotation");
   }
-  if (init == InitMode::moments_and_fit) {
-    const Eigen::Vector3d c = model.levels[0].colwise().mean().transpose();
-    const bool at_model_pose = pose.rotation_angle_deg() < 1.0 && std::abs(pose.scale - 1.0) < 0.01 &&
-                               (pose.apply(c) - c).norm() < spacings[0];
-    if (!at_model_pose) starts.emplace_back(Similarity{}, "model pose");
-  }
+  if (init == InitMode::moments_and_fit) starts.emplace_back(Similarity{}, "model pose");
   RegionStats stats;
   RowMatrixX3d N;
   const auto estimate_stats = [&](const RowMatrixX3d& W) {

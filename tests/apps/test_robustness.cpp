@@ -28,6 +28,8 @@ void expect_one_line_error(const mrsnake::test::CommandResult& r, int code, cons
   EXPECT_NE(r.output.find("mrsnake: error: "), std::string::npos) << r.output;
   EXPECT_NE(r.output.find(needle), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("itk::"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("ITK ERROR"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("(0x"), std::string::npos) << r.output;
 }
 
 /// A NIfTI-1 file with the given dimensions (uint8 voxels), written by hand so that 2D and
@@ -162,9 +164,17 @@ TEST_F(Robustness, MetaImageWithItsVoxelsInAnotherFile) {
                         "short.raw' is truncated");
   write_header("orphan.mhd", "gone.raw", 0);
   expect_one_line_error(run_mrsnake("mc --labels " + path("orphan.mhd") + " --label 1 -o " + path("o.vtp")), 3,
-                        "gone.raw");
+                        "gone.raw', which is missing");
+  write_header("orphanz.mhd", "gone.zraw", packed_size);
+  expect_one_line_error(run_mrsnake("mc --labels " + path("orphanz.mhd") + " --label 1 -o " + path("o.vtp")), 3,
+                        "gone.zraw', which is missing");
   EXPECT_FALSE(fs::exists(path("s.vtp")));
   EXPECT_FALSE(fs::exists(path("o.vtp")));
+
+  // A damaged NRRD header: ITK's multi-line reason in one line, without ITK's prefix.
+  std::ofstream(path("bad.nrrd")) << "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 20 20\nencoding: raw\n\nxx";
+  expect_one_line_error(run_mrsnake("mc --labels " + path("bad.nrrd") + " --label 1 -o " + path("b.vtp")), 3,
+                        "parsed 2 values, but dimension is 3");
 
   // The same for NRRD: a detached header (.nhdr) naming its raw file, and gzip encoding.
   const auto write_nhdr = [&](const std::string& name, const std::string& data_file) {
