@@ -85,6 +85,11 @@ void check_gzip_complete(const std::string& path) {
                      "); re-export or re-copy the file");
 }
 
+std::string lower_case(std::string text) {
+  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return text;
+}
+
 // The header lines of a MetaImage ("Key = Value", up to ElementDataFile) or NRRD ("key: value",
 // up to the first blank line) file, keys lower-cased without spaces.
 std::vector<std::pair<std::string, std::string>> header_fields(const std::string& path, char separator) {
@@ -98,7 +103,8 @@ std::vector<std::pair<std::string, std::string>> header_fields(const std::string
     if (at == std::string::npos) continue;
     std::string key, value = line.substr(at + 1);
     for (char c : line.substr(0, at))
-      if (!std::isspace(static_cast<unsigned char>(c))) key += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      if (!std::isspace(static_cast<unsigned char>(c))) key += c;
+    key = lower_case(key);
     value.erase(0, value.find_first_not_of(" \t"));
     value.erase(value.find_last_not_of(" \t") + 1);
     fields.emplace_back(key, value);
@@ -117,11 +123,7 @@ struct VoxelFile {
 };
 
 VoxelFile voxel_file(const std::string& path) {
-  const auto lower = [](std::string text) {
-    for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return text;
-  };
-  const std::string extension = lower(std::filesystem::path(path).extension().string());
+  const std::string extension = lower_case(std::filesystem::path(path).extension().string());
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
   if (extension == ".mha" || extension == ".mhd") {
     std::string data_file;
@@ -132,18 +134,18 @@ VoxelFile voxel_file(const std::string& path) {
       if (key == "elementdatafile") data_file = value;
     }
     // "LIST [2D]" and printf-style patterns spread the voxels over several files.
-    if (data_file.empty() || lower(data_file).rfind("list", 0) == 0 || data_file.find('%') != std::string::npos) return {};
-    return {lower(data_file) == "local" ? path : (folder / data_file).string(), !compressed};
+    if (data_file.empty() || lower_case(data_file).rfind("list", 0) == 0 || data_file.find('%') != std::string::npos) return {};
+    return {lower_case(data_file) == "local" ? path : (folder / data_file).string(), !compressed};
   }
   if (extension == ".nrrd" || extension == ".nhdr") {
     std::string data_file;
     bool raw = true;
     for (const auto& [key, value] : header_fields(path, ':')) {
-      if (key == "encoding") raw = lower(value) == "raw";
+      if (key == "encoding") raw = lower_case(value) == "raw";
       if (key == "datafile") data_file = value;
     }
     if (data_file.empty()) return extension == ".nrrd" ? VoxelFile{path, raw} : VoxelFile{};
-    if (data_file.find(' ') != std::string::npos || lower(data_file).rfind("list", 0) == 0) return {};
+    if (data_file.find(' ') != std::string::npos || lower_case(data_file).rfind("list", 0) == 0) return {};
     return {(folder / data_file).string(), raw};
   }
   if (extension == ".nii" || extension == ".gipl") return {path, true};

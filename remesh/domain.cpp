@@ -6,8 +6,6 @@
 #include <utility>
 #include <vector>
 
-#include "mesh/vertex_stars.h"
-
 namespace mrsnake {
 namespace {
 
@@ -74,8 +72,7 @@ int count_flipped(const RowMatrixX3d& D, const RowMatrixX3i& F) {
   return flipped;
 }
 
-std::vector<std::pair<int, int>> boundary_edges(const RowMatrixX3i& F, int num_vertices) {
-  const VertexStars stars(F, num_vertices);
+std::vector<std::pair<int, int>> boundary_edges(const RowMatrixX3i& F, const VertexStars& stars) {
   std::vector<std::pair<int, int>> edges;
   for (int f = 0; f < F.rows(); ++f)
     for (int e = 0; e < 3; ++e) {
@@ -85,10 +82,14 @@ std::vector<std::pair<int, int>> boundary_edges(const RowMatrixX3i& F, int num_v
   return edges;
 }
 
-std::vector<bool> boundary_vertices(const RowMatrixX3i& F, int num_vertices) {
-  std::vector<bool> boundary(num_vertices, false);
-  for (const auto& [a, b] : boundary_edges(F, num_vertices)) boundary[a] = boundary[b] = true;
+std::vector<bool> boundary_vertices(const RowMatrixX3i& F, const VertexStars& stars) {
+  std::vector<bool> boundary(stars.offset.size() - 1, false);
+  for (const auto& [a, b] : boundary_edges(F, stars)) boundary[a] = boundary[b] = true;
   return boundary;
+}
+
+std::vector<bool> boundary_vertices(const RowMatrixX3i& F, int num_vertices) {
+  return boundary_vertices(F, VertexStars(F, num_vertices));
 }
 
 DomainMesh::DomainMesh(RowMatrixX3d D, RowMatrixX3i F) : D_(std::move(D)), F_(std::move(F)) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "mesh/trimesh.h"
+#include "mesh/vertex_stars.h"
 
 namespace mrsnake {
 
@@ -29,10 +30,14 @@ int count_flipped(const RowMatrixX3d& D, const RowMatrixX3i& F);
 
 /// The directed edges a -> b of F, in face order, with no face running b -> a: the boundary,
 /// each edge with its face on the left.
-/// \pre every entry of F is in [0, num_vertices).
-std::vector<std::pair<int, int>> boundary_edges(const RowMatrixX3i& F, int num_vertices);
+/// \pre `stars` are F's vertex stars.
+std::vector<std::pair<int, int>> boundary_edges(const RowMatrixX3i& F, const VertexStars& stars);
 
 /// Vertices on a boundary edge (an edge used by one face).
+/// \pre `stars` are F's vertex stars.
+std::vector<bool> boundary_vertices(const RowMatrixX3i& F, const VertexStars& stars);
+
+/// The same, building the stars of F's `num_vertices` vertices.
 /// \pre every entry of F is in [0, num_vertices).
 std::vector<bool> boundary_vertices(const RowMatrixX3i& F, int num_vertices);
 

@@ -18,8 +18,8 @@ int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh&
   const int m = static_cast<int>(F.rows());
   if (snapped) snapped->assign(n, false);
   if (m == 0 || options.max_snaps <= 0) return 0;
-  const std::vector<bool> rim = kind == DomainKind::disk ? boundary_vertices(F, n) : std::vector<bool>(n, false);
   const VertexStars stars(F, n);
+  const std::vector<bool> rim = kind == DomainKind::disk ? boundary_vertices(F, stars) : std::vector<bool>(n, false);
   const auto& PF = param.faces();
   const auto& PD = param.positions();
   const int input_vertices = static_cast<int>(PD.rows());

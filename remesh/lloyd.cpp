@@ -55,8 +55,8 @@ LloydStats constrained_lloyd(DomainKind kind, const RowMatrixX3i& F, const Densi
   LloydStats stats;
   const int n = static_cast<int>(U.rows());
   const int m = static_cast<int>(F.rows());
-  const std::vector<bool> boundary = kind == DomainKind::disk ? boundary_vertices(F, n) : std::vector<bool>(n, false);
   const VertexStars star(F, n);
+  const std::vector<bool> boundary = kind == DomainKind::disk ? boundary_vertices(F, star) : std::vector<bool>(n, false);
   std::vector<int> face_hint(m);
   for (int f = 0; f < m; ++f) face_hint[f] = vertex_hints[F(f, 0)];
   const int r = std::min(48, static_cast<int>(std::floor(std::sqrt(static_cast<double>(options.sample_budget) / std::max(1, m)))));

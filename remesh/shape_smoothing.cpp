@@ -29,13 +29,13 @@ int smooth_shapes_in_domain(DomainKind kind, const RowMatrixX3i& F, const Domain
                             const RowMatrixX3d& surface_V, RowMatrixX3d& U, RowMatrixX3d& X,
                             std::vector<int>& hints, const ShapeSmoothingOptions& options) {
   const int n = static_cast<int>(U.rows());
+  const VertexStars stars(F, n);
   const std::vector<std::pair<int, int>> rim_edges =
-      kind == DomainKind::disk ? boundary_edges(F, n) : std::vector<std::pair<int, int>>();
+      kind == DomainKind::disk ? boundary_edges(F, stars) : std::vector<std::pair<int, int>>();
   std::vector<bool> boundary(n, false);
   for (const auto& [a, b] : rim_edges) boundary[a] = boundary[b] = true;
   const std::vector<Eigen::Vector2i> rim =
       kind == DomainKind::disk && options.move_rim ? rim_neighbours(rim_edges, n) : std::vector<Eigen::Vector2i>();
-  const VertexStars stars(F, n);
   const auto& PF = param.faces();
   const auto& PD = param.positions();
   const bool weighted = options.target == SmoothingTarget::area_centroid && options.surface_density != nullptr;

@@ -18,8 +18,8 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
                                            std::vector<int>& hints, const TriangleRepairOptions& options) {
   const int n = static_cast<int>(U.rows());
   const int m = static_cast<int>(F.rows());
-  const std::vector<bool> boundary = kind == DomainKind::disk ? boundary_vertices(F, n) : std::vector<bool>(n, false);
   const VertexStars stars(F, n);
+  const std::vector<bool> boundary = kind == DomainKind::disk ? boundary_vertices(F, stars) : std::vector<bool>(n, false);
   const auto& PF = param.faces();
   const auto& PD = param.positions();
   auto quality = [&](int f, int v, const Eigen::Vector3d& x) {
