@@ -4,10 +4,18 @@
 #include <chrono>
 #include <cmath>
 #include <complex>
+#include <array>
+#include <future>
 #include <limits>
+#include <numeric>
+#include <system_error>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 
 #include "mesh/errors.h"
 #include "mesh/topology.h"
+#include "mesh/vertex_stars.h"
 
 namespace mrsnake {
 namespace {
@@ -94,6 +102,288 @@ int balance_disk(RowMatrixX3d& D, const Eigen::VectorXd& weights) {
   return it;
 }
 
+
+// One half of a closed surface cut in two: its faces as a mesh of its own, and where its
+// vertices come from.
+struct Half {
+  TriMesh mesh;
+  std::vector<int> to_surface;  ///< half vertex -> surface vertex
+};
+
+Half extract_half(const TriMesh& mesh, const std::vector<int>& faces) {
+  // Vertices keep their relative order (as remove_unreferenced_vertices does).
+  std::vector<int> to_half(mesh.num_vertices(), -1);
+  for (int f : faces)
+    for (int k = 0; k < 3; ++k) to_half[mesh.F(f, k)] = 0;
+  Half half;
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    if (to_half[v] == 0) {
+      to_half[v] = static_cast<int>(half.to_surface.size());
+      half.to_surface.push_back(v);
+    }
+  half.mesh.V.resize(static_cast<Eigen::Index>(half.to_surface.size()), 3);
+  for (std::size_t h = 0; h < half.to_surface.size(); ++h) half.mesh.V.row(static_cast<Eigen::Index>(h)) = mesh.V.row(half.to_surface[h]);
+  half.mesh.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+  for (std::size_t i = 0; i < faces.size(); ++i)
+    for (int k = 0; k < 3; ++k) half.mesh.F(static_cast<Eigen::Index>(i), k) = to_half[mesh.F(faces[i], k)];
+  return half;
+}
+
+// Runs a() here and b() on another thread, and returns after both; rethrows their first exception.
+template <class A, class B>
+void run_both(A&& a, B&& b) {
+  std::future<void> other;
+  try {
+    other = std::async(std::launch::async, std::forward<B>(b));
+  } catch (const std::system_error&) {  // no thread available: one after the other
+    a();
+    b();
+    return;
+  }
+  std::exception_ptr error;
+  try {
+    a();
+  } catch (...) {
+    error = std::current_exception();
+  }
+  other.wait();
+  if (error) std::rethrow_exception(error);
+  other.get();
+}
+
+// A face whose three corners all lie on the cut would have its three corners on the equator:
+// a degenerate triangle of the sphere. Most are ears of a jagged cut (two or three of their
+// edges on it); each moves to the other side, one at a time. Every move shortens the cut, so
+// the sweeps end. Returns false if such faces are left.
+double smooth_cut(const TriMesh& mesh, const VertexStars& stars, std::vector<int>& side) {
+  const int n = mesh.num_vertices(), m = mesh.num_faces();
+  // The face across the edge from corner k to corner k+1 of f (-1 if none).
+  const auto across = [&](int f, int k) {
+    const int a = mesh.F(f, k), b = mesh.F(f, (k + 1) % 3);
+    for (int i = stars.offset[a]; i < stars.offset[a + 1]; ++i) {
+      const int g = stars.faces[i];
+      for (int j = 0; j < 3; ++j)
+        if (g != f && mesh.F(g, j) == b && mesh.F(g, (j + 1) % 3) == a) return g;
+    }
+    return -1;
+  };
+  std::vector<std::array<int, 2>> count(n, {0, 0});  // faces of each side around each vertex
+  for (int f = 0; f < m; ++f)
+    for (int k = 0; k < 3; ++k) ++count[mesh.F(f, k)][side[f]];
+  const auto on_cut = [&](int v) { return count[v][0] > 0 && count[v][1] > 0; };
+  // The 3D angle each side makes at each vertex. The disk maps open every cut vertex's side
+  // to a straight angle: a narrow spike of one side (a plane cut zigzags along mesh edges)
+  // would be stretched several times over. Spikes move to the other side.
+  std::vector<std::array<double, 2>> angle(n, {0.0, 0.0});
+  RowMatrixX3d corner(m, 3);
+  for (int f = 0; f < m; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p = mesh.V.row(mesh.F(f, k)), a = mesh.V.row(mesh.F(f, (k + 1) % 3)), b = mesh.V.row(mesh.F(f, (k + 2) % 3));
+      corner(f, k) = std::atan2((a - p).cross(b - p).norm(), (a - p).dot(b - p));
+      angle[mesh.F(f, k)][side[f]] += corner(f, k);
+    }
+  const auto move = [&](int f) {
+    for (int k = 0; k < 3; ++k) {
+      const int v = mesh.F(f, k);
+      --count[v][side[f]];
+      ++count[v][side[f] ^ 1];
+      angle[v][side[f]] -= corner(f, k);
+      angle[v][side[f] ^ 1] += corner(f, k);
+    }
+    side[f] ^= 1;
+  };
+  for (int sweep = 0; sweep < 8; ++sweep) {
+    bool moved = false;
+    for (int v = 0; v < n; ++v) {
+      if (!on_cut(v)) continue;
+      for (int s = 0; s < 2; ++s)
+        if (angle[v][s] < 0.6 * M_PI && angle[v][s ^ 1] > angle[v][s]) {
+          for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i)
+            if (side[stars.faces[i]] == s) move(stars.faces[i]);
+          moved = true;
+          break;
+        }
+    }
+    if (!moved) break;
+  }
+  for (bool moved = true; moved;) {
+    moved = false;
+    for (int f = 0; f < m; ++f) {
+      if (!(on_cut(mesh.F(f, 0)) && on_cut(mesh.F(f, 1)) && on_cut(mesh.F(f, 2)))) continue;
+      int cut_edges = 0;
+      for (int k = 0; k < 3; ++k) {
+        const int g = across(f, k);
+        cut_edges += g >= 0 && side[g] != side[f];
+      }
+      if (cut_edges < 2) continue;
+      move(f);
+      moved = true;
+    }
+  }
+  double length = 0;
+  for (int f = 0; f < m; ++f) {
+    if (on_cut(mesh.F(f, 0)) && on_cut(mesh.F(f, 1)) && on_cut(mesh.F(f, 2))) return -1;
+    for (int k = 0; k < 3; ++k) {
+      const int g = across(f, k);
+      if (g > f && side[g] != side[f]) length += (mesh.V.row(mesh.F(f, k)) - mesh.V.row(mesh.F(f, (k + 1) % 3))).norm();
+    }
+  }
+  return length;
+}
+
+// Cuts a closed genus-0 surface into two topological disks of equal area: the faces on each
+// side of a plane through the area centroid, across its longest principal axis first (a smooth
+// level set, so the cut is one loop on most organs; the other axes are tried next). Returns
+// false when no axis gives two disks.
+bool split_into_two_disks(const TriMesh& mesh, std::array<Half, 2>& halves, int& axis_used) {
+  const int m = mesh.num_faces();
+  RowMatrixX3d centroid(m, 3);
+  Eigen::VectorXd area(m);
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int f = 0; f < m; ++f) {
+    centroid.row(f) = (mesh.V.row(mesh.F(f, 0)) + mesh.V.row(mesh.F(f, 1)) + mesh.V.row(mesh.F(f, 2))) / 3.0;
+    area[f] = face_area(mesh.V, mesh.F, f);
+    mean += area[f] * centroid.row(f).transpose();
+  }
+  const double total = area.sum();
+  if (!(total > 0)) return false;
+  mean /= total;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (int f = 0; f < m; ++f) {
+    const Eigen::Vector3d d = centroid.row(f).transpose() - mean;
+    covariance += area[f] * d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> principal(covariance);
+  const VertexStars stars(mesh.F, mesh.num_vertices());
+  // Each principal plane's cut, shortest first: a short cut distorts the two maps least.
+  std::vector<std::pair<double, std::vector<int>>> cuts;
+  std::vector<int> axes;
+  for (int axis_index = 0; axis_index < 3; ++axis_index) {
+    const Eigen::Vector3d axis = principal.eigenvectors().col(2 - axis_index);  // eigenvalues ascend
+    const Eigen::VectorXd height = (centroid.rowwise() - mean.transpose()) * axis;
+    // The area-weighted median height: equal areas, so the two solves take about as long.
+    std::vector<int> order(m);
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return height[a] < height[b]; });
+    double below = 0;
+    int split = 0;
+    while (split < m && below + area[order[split]] <= 0.5 * total) below += area[order[split++]];
+    if (split == 0 || split == m) continue;
+    std::vector<int> side(m, 1);
+    for (int i = 0; i < split; ++i) side[order[i]] = 0;
+    const double length = smooth_cut(mesh, stars, side);
+    if (length <= 0) continue;
+    cuts.emplace_back(length, std::move(side));
+    axes.push_back(axis_index);
+  }
+  std::vector<int> by_length(cuts.size());
+  std::iota(by_length.begin(), by_length.end(), 0);
+  std::sort(by_length.begin(), by_length.end(), [&](int a, int b) { return cuts[a].first < cuts[b].first; });
+  for (int c : by_length) {
+    const std::vector<int>& side = cuts[c].second;
+    std::array<std::vector<int>, 2> faces;
+    for (int f = 0; f < m; ++f) faces[side[f]].push_back(f);
+    std::array<bool, 2> disk{};
+    run_both([&] { halves[0] = extract_half(mesh, faces[0]); disk[0] = topology_report(halves[0].mesh).is_disk(); },
+             [&] { halves[1] = extract_half(mesh, faces[1]); disk[1] = topology_report(halves[1].mesh).is_disk(); });
+    if (disk[0] && disk[1]) {
+      axis_used = axes[c];
+      return true;
+    }
+  }
+  return false;
+}
+
+// Signed area of the disk map's triangles (positive when counter-clockwise).
+double signed_area(const Eigen::MatrixX2d& xy, const RowMatrixX3i& F) {
+  double sum = 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector2d a = xy.row(F(f, 0)), b = xy.row(F(f, 1)), c = xy.row(F(f, 2));
+    sum += (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+  }
+  return 0.5 * sum;
+}
+
+// The two halves' disk maps glued into one map onto the sphere: half 0 onto the northern
+// hemisphere, half 1 onto the southern, each by inverse stereographic projection, the cut on
+// the equator. Both disks put the cut on the unit circle by arc length, so they agree there
+// up to a rotation and a reflection, which are undone here. Returns false if they do not agree.
+bool glue_hemispheres(const TriMesh& mesh, const std::array<Half, 2>& halves, std::array<Eigen::MatrixX2d, 2> xy,
+                      RowMatrixX3d& domain) {
+  // Half 0 counter-clockwise (outward on the north), half 1 clockwise (outward on the south).
+  for (int i = 0; i < 2; ++i)
+    if ((signed_area(xy[i], halves[i].mesh.F) < 0) == (i == 0)) xy[i].col(1) *= -1.0;
+  std::vector<int> cut_position(mesh.num_vertices(), -1);  // surface vertex -> row of half 0
+  for (std::size_t h = 0; h < halves[0].to_surface.size(); ++h) cut_position[halves[0].to_surface[h]] = static_cast<int>(h);
+  // The rotation taking half 1's circle onto half 0's, from one shared vertex.
+  double rotation = 0;
+  bool found = false;
+  for (std::size_t h = 0; h < halves[1].to_surface.size() && !found; ++h) {
+    const int in0 = cut_position[halves[1].to_surface[h]];
+    if (in0 < 0) continue;
+    rotation = std::atan2(xy[0](in0, 1), xy[0](in0, 0)) - std::atan2(xy[1](h, 1), xy[1](h, 0));
+    found = true;
+  }
+  if (!found) return false;
+  const Eigen::Matrix2d turn = Eigen::Rotation2Dd(rotation).toRotationMatrix();
+  xy[1] = (xy[1] * turn.transpose()).eval();
+  for (std::size_t h = 0; h < halves[1].to_surface.size(); ++h) {
+    const int in0 = cut_position[halves[1].to_surface[h]];
+    if (in0 < 0) continue;
+    if ((xy[1].row(h) - xy[0].row(in0)).norm() > 1e-6) return false;
+    xy[1].row(h) = xy[0].row(in0);  // exactly the same point on the equator
+  }
+  domain.resize(mesh.num_vertices(), 3);
+  for (int i = 0; i < 2; ++i)
+    for (std::size_t h = 0; h < halves[i].to_surface.size(); ++h) {
+      const double x = xy[i](h, 0), y = xy[i](h, 1), s = x * x + y * y;
+      const double z = (1 - s) / (1 + s);
+      domain.row(halves[i].to_surface[h]) << 2 * x / (1 + s), 2 * y / (1 + s), i == 0 ? z : -z;
+    }
+  return true;
+}
+
+// The punctured map: the star of one well-shaped vertex removed, the rest mapped to the unit
+// disk and lifted onto the sphere by inverse stereographic projection from that vertex, which
+// goes to the pole (0, 0, 1). Returns the pole vertex.
+int punctured_sphere_map(const TriMesh& mesh, RowMatrixX3d& domain) {
+  const int n = mesh.num_vertices();
+  const int pole = choose_puncture_vertex(mesh);
+  std::vector<int> keep;
+  for (int f = 0; f < mesh.num_faces(); ++f)
+    if (mesh.F(f, 0) != pole && mesh.F(f, 1) != pole && mesh.F(f, 2) != pole) keep.push_back(f);
+  const Half disk = extract_half(mesh, keep);
+  const Eigen::MatrixX2d uv = mean_value_disk_map(disk.mesh);
+  domain.resize(n, 3);
+  for (std::size_t i = 0; i < disk.to_surface.size(); ++i) {
+    // The disk's rim goes to the equator.
+    const double x = 2 * uv(i, 0) - 1, y = 2 * uv(i, 1) - 1, s = x * x + y * y;
+    domain.row(disk.to_surface[i]) << 2 * x / (1 + s), 2 * y / (1 + s), (s - 1) / (1 + s);
+  }
+  domain.row(pole) << 0, 0, 1;
+  return pole;
+}
+
+// The two-halves map: the surface cut into two disks, each mapped to the unit disk on its own
+// core, then glued along the cut onto the sphere. Returns false (and leaves the outputs
+// unspecified) when no principal plane cuts the surface into two disks.
+bool two_halves_sphere_map(const TriMesh& mesh, RowMatrixX3d& domain, std::vector<int>& cut, nlohmann::json& summary) {
+  std::array<Half, 2> halves;
+  int axis = -1;
+  if (!split_into_two_disks(mesh, halves, axis)) return false;
+  std::array<Eigen::MatrixX2d, 2> xy;
+  run_both([&] { xy[0] = mean_value_disk_map(halves[0].mesh); }, [&] { xy[1] = mean_value_disk_map(halves[1].mesh); });
+  for (auto& uv : xy) uv = (2.0 * uv.array() - 1.0).matrix();
+  if (!glue_hemispheres(mesh, halves, xy, domain)) return false;
+  std::vector<bool> in_first(mesh.num_vertices(), false);
+  for (int v : halves[0].to_surface) in_first[v] = true;
+  cut.clear();
+  for (int v : halves[1].to_surface)
+    if (in_first[v]) cut.push_back(v);
+  summary["cut_axis"] = axis;
+  summary["cut_vertices"] = static_cast<int>(cut.size());
+  return true;
+}
 }  // namespace
 
 Eigen::Vector3d mobius_to_center(const Eigen::Vector3d& a, const Eigen::Vector3d& x) {
@@ -101,7 +391,7 @@ Eigen::Vector3d mobius_to_center(const Eigen::Vector3d& a, const Eigen::Vector3d
   return (1.0 - a.squaredNorm()) * d / d.squaredNorm() - a;
 }
 
-Parameterization parameterize(const TriMesh& input) {
+Parameterization parameterize(const TriMesh& input, const ParameterizationOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   Parameterization param;
   param.surface = remove_unreferenced_vertices(input);
@@ -127,33 +417,16 @@ Parameterization parameterize(const TriMesh& input) {
     balance_iterations = balance_disk(param.domain, weights);
   } else {
     param.kind = DomainKind::sphere;
-    const int pole = choose_puncture_vertex(mesh);
-    std::vector<int> keep;
-    std::vector<int> star;
-    for (int f = 0; f < mesh.num_faces(); ++f)
-      ((mesh.F(f, 0) == pole || mesh.F(f, 1) == pole || mesh.F(f, 2) == pole) ? star : keep).push_back(f);
-    // The punctured surface with `pole` dropped; old -> new vertex indices.
-    std::vector<int> to_disk(n, -1), to_mesh;
-    for (int v = 0; v < n; ++v)
-      if (v != pole) {
-        to_disk[v] = static_cast<int>(to_mesh.size());
-        to_mesh.push_back(v);
-      }
-    TriMesh disk;
-    disk.V.resize(n - 1, 3);
-    for (int i = 0; i < n - 1; ++i) disk.V.row(i) = mesh.V.row(to_mesh[i]);
-    disk.F.resize(static_cast<int>(keep.size()), 3);
-    for (std::size_t i = 0; i < keep.size(); ++i)
-      for (int k = 0; k < 3; ++k) disk.F(static_cast<int>(i), k) = to_disk[mesh.F(keep[i], k)];
+    const bool halves = options.sphere_map == SphereMap::two_halves ||
+                        (options.sphere_map == SphereMap::automatic && mesh.num_faces() >= options.halves_from_faces);
     const auto solve_start = std::chrono::steady_clock::now();
-    const Eigen::MatrixX2d uv = mean_value_disk_map(disk);
-    param.summary["solver_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
-    for (int i = 0; i < n - 1; ++i) {
-      // Inverse stereographic projection from the pole (0, 0, 1); the disk's rim goes to the equator.
-      const double x = 2 * uv(i, 0) - 1, y = 2 * uv(i, 1) - 1, s = x * x + y * y;
-      param.domain.row(to_mesh[i]) << 2 * x / (1 + s), 2 * y / (1 + s), (s - 1) / (1 + s);
+    param.sphere_map = halves && two_halves_sphere_map(mesh, param.domain, param.cut, param.summary) ? SphereMap::two_halves
+                                                                                                    : SphereMap::punctured;
+    if (param.sphere_map == SphereMap::punctured) {
+      const int pole = punctured_sphere_map(mesh, param.domain);
+      param.summary["pole_vertex"] = pole;
     }
-    param.domain.row(pole) << 0, 0, 1;
+    param.summary["solver_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
     int negative = 0;
     for (int f = 0; f < mesh.num_faces(); ++f)
       if (domain_orientation(param.domain.row(mesh.F(f, 0)), param.domain.row(mesh.F(f, 1)),
@@ -161,7 +434,6 @@ Parameterization parameterize(const TriMesh& input) {
         ++negative;
     if (2 * negative > mesh.num_faces()) param.domain.col(0) *= -1.0;  // stereographic projection reverses orientation
     balance_iterations = balance_sphere(param.domain, weights);
-    param.summary["pole_vertex"] = pole;
   }
 
   const int flipped = count_flipped(param.domain, mesh.F);
@@ -201,9 +473,12 @@ Parameterization parameterize(const TriMesh& input) {
                          std::to_string(static_cast<int>(std::log10(hi / lo))) +
                          " orders of magnitude): long protrusions cannot be remeshed from one chart; simplify the shape");
 
-  param.summary["method"] = param.kind == DomainKind::sphere
-                                ? "mean value coordinates of the punctured sphere, inverse stereographic, Mobius balanced"
-                                : "mean value coordinates on the unit disk, Mobius balanced";
+  param.summary["method"] =
+      param.kind == DomainKind::disk ? "mean value coordinates on the unit disk, Mobius balanced"
+      : param.sphere_map == SphereMap::two_halves
+          ? "mean value coordinates of two halves cut across a principal axis, one per hemisphere by inverse "
+            "stereographic projection, Mobius balanced"
+          : "mean value coordinates of the punctured sphere, inverse stereographic, Mobius balanced";
   param.summary["domain"] = param.kind == DomainKind::sphere ? "sphere" : "disk";
   param.summary["balance_iterations"] = balance_iterations;
   param.summary["stretch_min"] = sorted.front() / mean_stretch;

@@ -3,11 +3,17 @@
 /// Maps a disk or closed genus-0 surface onto the domain D and measures its area distortion.
 ///
 /// Disk: CGAL mean value coordinates with the boundary on the unit circle by arc length
-/// (Floater's theorem: no flipped triangle). Closed genus 0: the star of one well-shaped
-/// vertex is removed, the rest is mapped to the unit disk the same way (a discrete
-/// approximation of the conformal map of the punctured sphere), lifted onto the sphere by
-/// inverse stereographic projection with the removed vertex at the pole, then balanced by
-/// Möbius transformations until the area-weighted centroid sits at the centre. No seam.
+/// (Floater's theorem: no flipped triangle). Closed genus 0, either
+/// - punctured: the star of one well-shaped vertex is removed, the rest is mapped to the unit
+///   disk the same way (a discrete approximation of the conformal map of the punctured
+///   sphere) and lifted onto the sphere by inverse stereographic projection with the removed
+///   vertex at the pole; or
+/// - two halves: the surface is cut into two disks of equal area along a principal plane (its
+///   spikes smoothed away), each is mapped to the unit disk the same way, on its own core, and
+///   lifted onto one hemisphere, the cut onto the equator (both disks put it on the circle by
+///   arc length, so they agree there). The map is continuous, with a kink along the cut.
+/// Either is then balanced by Möbius transformations until the area-weighted centroid sits at
+/// the centre. No seam in D.
 #include <nlohmann/json.hpp>
 
 #include "mesh/trimesh.h"
@@ -15,20 +21,43 @@
 
 namespace mrsnake {
 
+/// How a closed genus-0 surface is mapped onto the sphere.
+enum class SphereMap {
+  /// two_halves for surfaces of at least ParameterizationOptions::halves_from_faces faces,
+  /// where the sparse solve dominates; punctured below.
+  automatic,
+  /// One vertex's star removed, the rest mapped to one disk: one sparse solve.
+  punctured,
+  /// Cut in two disks of equal area across a principal plane, one per hemisphere: two
+  /// half-size solves, in parallel (falls back to punctured when no principal plane cuts the
+  /// surface into two disks).
+  two_halves
+};
+
+struct ParameterizationOptions {
+  SphereMap sphere_map = SphereMap::automatic;
+  /// With automatic: the face count from which the two-halves map is used. On the 179k-face
+  /// liver it takes 0.46 s instead of 0.84 s; on the 28k-face bear both take 0.1 s and the
+  /// punctured map's triangles come out slightly better (docs/bench-build-model.md).
+  int halves_from_faces = 100000;
+};
+
 /// The input surface T embedded in D.
 struct Parameterization {
   DomainKind kind = DomainKind::sphere;
+  SphereMap sphere_map = SphereMap::punctured;  ///< the map used (punctured or two_halves), when kind is sphere
   TriMesh surface;                 ///< the input, unreferenced vertices dropped
   RowMatrixX3d domain;             ///< position in D of each vertex of `surface`
   Eigen::VectorXd face_stretch;    ///< per face: A3D / A_D (the inverse of the paper's distortion d)
   Eigen::VectorXd vertex_stretch;  ///< per vertex: sum of incident A3D / sum of incident A_D
+  std::vector<int> cut;            ///< with two_halves: the surface vertices on the cut (the equator of D)
   nlohmann::json summary;          ///< method, distortion range, seconds
 };
 
 /// \pre input is a disk or a closed genus-0 surface.
 /// \throw TopologyError if it is neither.
 /// \throw AlgorithmError if the solver fails, a triangle flips, or the distortion is extreme.
-Parameterization parameterize(const TriMesh& input);
+Parameterization parameterize(const TriMesh& input, const ParameterizationOptions& options = {});
 
 /// CGAL mean value coordinates of a disk, boundary fixed on the unit circle by arc length.
 /// Returns one (u, v) row per vertex.

@@ -114,7 +114,9 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   }
 
   report(options.progress, "parameterize", 0);
-  const Parameterization param = parameterize(work);
+  ParameterizationOptions param_options;
+  param_options.sphere_map = options.sphere_map;
+  const Parameterization param = parameterize(work, param_options);
   result.domain = param.kind == DomainKind::sphere ? "sphere" : "disk";
   const nlohmann::json simplify_info = result.parameterization;
   result.parameterization = param.summary;

@@ -15,6 +15,7 @@
 #include "mesh/progress.h"
 #include "mesh/subdivision.h"
 #include "mesh/trimesh.h"
+#include "remesh/parameterization.h"
 
 namespace mrsnake {
 
@@ -35,6 +36,8 @@ struct RemeshOptions {
   /// Number of base vertices when `levels` is given (ignored with target_faces).
   int base_vertices = 32;
   RelaxMode relax = RelaxMode::all_vertices;
+  /// How a closed genus-0 input is mapped onto the sphere (remesh/parameterization.h).
+  SphereMap sphere_map = SphereMap::automatic;
   /// The Lloyd density is stretch^density_exponent, stretch = A3D/A_D. 2 makes the 3D
   /// spacing even (2D Lloyd spaces points as density^(-1/4)).
   double density_exponent = 2.0;

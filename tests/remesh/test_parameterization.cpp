@@ -2,6 +2,7 @@
 // ordering and factorization, the disk map must solve Floater's mean value system.
 #include <gtest/gtest.h>
 
+#include <Eigen/SVD>
 #include <Eigen/SparseLU>
 
 #include <algorithm>
@@ -108,4 +109,75 @@ TEST(MeanValueMap, SolvesTheMeanValueSystemAsAPlainSparseLUDoesWithoutFlips) {
     (orientation > 0 ? positive : negative)++;
   }
   EXPECT_TRUE(positive == 0 || negative == 0) << positive << " vs " << negative;
+}
+
+// The two-halves map of a closed surface: each half's disk map lifted onto one hemisphere, the
+// two glued along the cut. Whatever the Möbius balancing does after, the map must be an
+// embedding in the sphere (no flipped triangle, every point on it), and the cut, where the two
+// solves meet, must lie on one circle of the sphere: a Möbius transformation maps the equator
+// to a circle, a plane section.
+TEST(SphereMap, TwoHalvesGlueAlongOneCircleOfTheSphereWithoutFlips) {
+  const TriMesh input = test::ellipsoid(5);
+  ParameterizationOptions options;
+  options.sphere_map = SphereMap::two_halves;
+  const Parameterization p = parameterize(input, options);
+  ASSERT_EQ(p.kind, DomainKind::sphere);
+  ASSERT_EQ(p.sphere_map, SphereMap::two_halves);
+  EXPECT_EQ(p.summary.at("cut_axis").get<int>(), 0);  // across the longest axis: the shortest cut
+  ASSERT_GT(p.cut.size(), 30u);
+  EXPECT_EQ(count_flipped(p.domain, p.surface.F), 0);
+  EXPECT_LT(((p.domain.rowwise().norm().array() - 1.0).abs()).maxCoeff(), 1e-9);
+
+  RowMatrixX3d on_cut(static_cast<Eigen::Index>(p.cut.size()), 3);
+  for (std::size_t i = 0; i < p.cut.size(); ++i) on_cut.row(static_cast<Eigen::Index>(i)) = p.domain.row(p.cut[i]);
+  const Eigen::RowVector3d centre = on_cut.colwise().mean();
+  const RowMatrixX3d centred = on_cut.rowwise() - centre;
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(centred, Eigen::ComputeThinV);
+  const Eigen::Vector3d normal = svd.matrixV().col(2);
+  EXPECT_LT((centred * normal).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_GT(svd.singularValues()[1], 0.1 * svd.singularValues()[0]);  // a circle, not a few points on a line
+
+  // The cut's plane splits the surface's vertices into the two halves: every vertex off the
+  // cut is on one side of it, half the area on each (the cut is at the median).
+  const Eigen::VectorXd side = (p.domain.rowwise() - centre) * normal;
+  double area_above = 0, area_total = 0;
+  for (int f = 0; f < p.surface.num_faces(); ++f) {
+    const Eigen::Vector3d a = p.surface.V.row(p.surface.F(f, 0)), b = p.surface.V.row(p.surface.F(f, 1)),
+                          c = p.surface.V.row(p.surface.F(f, 2));
+    const double area = 0.5 * (b - a).cross(c - a).norm();
+    const double s = side[p.surface.F(f, 0)] + side[p.surface.F(f, 1)] + side[p.surface.F(f, 2)];
+    area_total += area;
+    if (s > 0) area_above += area;
+  }
+  EXPECT_NEAR(area_above / area_total, 0.5, 0.02);
+}
+
+TEST(SphereMap, AutomaticTakesTheTwoHalvesFromTheFaceCountOnAndThePuncturedMapBelow) {
+  const TriMesh input = test::ellipsoid(4);  // 5120 faces
+  ParameterizationOptions options;
+  options.halves_from_faces = 5120;
+  EXPECT_EQ(parameterize(input, options).sphere_map, SphereMap::two_halves);
+  options.halves_from_faces = 5121;
+  const Parameterization punctured = parameterize(input, options);
+  EXPECT_EQ(punctured.sphere_map, SphereMap::punctured);
+  EXPECT_TRUE(punctured.cut.empty());
+  EXPECT_EQ(count_flipped(punctured.domain, punctured.surface.F), 0);
+  EXPECT_EQ(ParameterizationOptions{}.sphere_map, SphereMap::automatic);
+}
+
+// A tetrahedron has no cut into two disks without faces whose three corners all lie on the
+// cut (degenerate on the equator): the two-halves map must fall back to the punctured one.
+TEST(SphereMap, FallsBackToThePuncturedMapWhenNoPlaneCutsTwoDisks) {
+  TriMesh tetrahedron;
+  tetrahedron.V.resize(4, 3);
+  tetrahedron.V << 1, 1, 1, 1, -1, -1, -1, 1, -1, -1, -1, 1;
+  tetrahedron.F.resize(4, 3);
+  tetrahedron.F << 0, 1, 2, 0, 3, 1, 0, 2, 3, 1, 3, 2;
+  ASSERT_TRUE(topology_report(tetrahedron).is_closed_genus0());
+  ParameterizationOptions options;
+  options.sphere_map = SphereMap::two_halves;
+  const Parameterization p = parameterize(tetrahedron, options);
+  EXPECT_EQ(p.sphere_map, SphereMap::punctured);
+  EXPECT_TRUE(p.cut.empty());
+  EXPECT_EQ(count_flipped(p.domain, p.surface.F), 0);
 }

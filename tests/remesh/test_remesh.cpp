@@ -89,11 +89,15 @@ void expect_nested_and_valid(const RemeshResult& r, const TriMesh& input, bool c
   }
 }
 
-TEST(Remesh, EllipsoidNestsExactlyWithoutFlipsInEveryMode) {
+TEST(Remesh, EllipsoidNestsExactlyWithoutFlipsInEveryModeAndSphereMap) {
   const TriMesh input = ellipsoid(4);
+  for (SphereMap map : {SphereMap::punctured, SphereMap::two_halves})
   for (RelaxMode mode : {RelaxMode::all_vertices, RelaxMode::new_vertices_only, RelaxMode::none}) {
-    SCOPED_TRACE(static_cast<int>(mode));
-    const RemeshResult r = remesh(input, small_options(3, 20, mode));
+    SCOPED_TRACE(std::to_string(static_cast<int>(map)) + " " + std::to_string(static_cast<int>(mode)));
+    RemeshOptions options = small_options(3, 20, mode);
+    options.sphere_map = map;
+    const RemeshResult r = remesh(input, options);
+    EXPECT_EQ(r.parameterization.contains("cut_vertices"), map == SphereMap::two_halves);
     EXPECT_EQ(r.domain, "sphere");
     EXPECT_EQ(r.connectivity.vertex_count(0), 20);
     EXPECT_EQ(r.connectivity.faces[0].rows(), 36);  // closed: F0 = 2 n0 - 4
@@ -433,10 +437,12 @@ TEST(RemeshData, MushroomBaseRimVerticesHaveThreeTriangles) {
 // Real meshes: zero flipped triangles at every level (kept small for a fast suite).
 void expect_no_flips_on(const std::string& path) {
   const TriMesh input = read_mesh(path);
+  for (SphereMap map : {SphereMap::punctured, SphereMap::two_halves})
   for (RelaxMode mode : {RelaxMode::all_vertices, RelaxMode::new_vertices_only, RelaxMode::none}) {
     RemeshOptions o;
     o.target_faces = 4000;
     o.relax = mode;
+    o.sphere_map = map;
     o.compute_stats = false;
     const RemeshResult r = remesh(input, o);
     for (int j = 0; j <= r.connectivity.levels(); ++j) {
@@ -488,6 +494,14 @@ TEST(RemeshCli, WritesNestedLevelsAndReport) {
     EXPECT_TRUE(level["distance"].contains("hausdorff_pct"));
     EXPECT_EQ(level["flipped_triangles"].get<int>(), 0);
   }
+  // A small input takes the punctured map by default; --sphere-map halves asks for the cut.
+  EXPECT_FALSE(report["parameterization"].contains("cut_vertices"));
+  const auto halves = test::run_mrsnake("-q remesh " + input + " -o " + (dir / "halves").string() +
+                                        " --levels 2 --base-vertices 12 --sphere-map halves");
+  ASSERT_EQ(halves.exit_code, 0) << halves.output;
+  std::ifstream in_halves(dir / "halves" / "report.json");
+  EXPECT_GT(nlohmann::json::parse(in_halves)["parameterization"].value("cut_vertices", 0), 0);
+  EXPECT_NE(test::run_mrsnake("-q remesh " + input + " -o " + (dir / "bad").string() + " --sphere-map north").exit_code, 0);
   std::filesystem::remove_all(dir);
 }
 
