@@ -9,6 +9,7 @@
 #include <limits>
 #include <numeric>
 #include <system_error>
+#include <thread>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -129,13 +130,18 @@ Half extract_half(const TriMesh& mesh, const std::vector<int>& faces) {
   return half;
 }
 
-// Runs a() here and b() on another thread, and returns after both; rethrows their first exception.
+// Runs a() here and b() on another thread (one after the other without a second core or when
+// no thread can be started), and returns after both; rethrows a()'s exception, else b()'s.
 template <class A, class B>
 void run_both(A&& a, B&& b) {
   std::future<void> other;
-  try {
-    other = std::async(std::launch::async, std::forward<B>(b));
-  } catch (const std::system_error&) {  // no thread available: one after the other
+  if (std::thread::hardware_concurrency() > 1) {
+    try {
+      other = std::async(std::launch::async, [&b] { b(); });
+    } catch (const std::system_error&) {
+    }
+  }
+  if (!other.valid()) {
     a();
     b();
     return;
@@ -151,10 +157,16 @@ void run_both(A&& a, B&& b) {
   other.get();
 }
 
-// A face whose three corners all lie on the cut would have its three corners on the equator:
-// a degenerate triangle of the sphere. Most are ears of a jagged cut (two or three of their
-// edges on it); each moves to the other side, one at a time. Every move shortens the cut, so
-// the sweeps end. Returns false if such faces are left.
+// Cleans up the cut between the faces of side 0 and side 1 (the side of each face, changed in
+// place), whose vertices all go to the equator of the sphere:
+// - spikes, where one side's 3D angle at a cut vertex is below 0.6π (the disk map opens it to
+//   π) and below the other side's, move to the other side, in up to 8 sweeps (a move can make
+//   a spike next to it; moving only when the spikes around get fewer kept more of them and
+//   gave worse triangles on the liver);
+// - ears, faces with three corners on the cut and two or three edges on it (degenerate on the
+//   equator), move to the other side, one at a time; each move shortens the cut, so this ends.
+// Returns the cut's 3D length, or -1 if a chord is left (an edge inside one side with both
+// ends on the cut).
 double smooth_cut(const TriMesh& mesh, const VertexStars& stars, std::vector<int>& side) {
   const int n = mesh.num_vertices(), m = mesh.num_faces();
   // The face across the edge from corner k to corner k+1 of f (-1 if none).
@@ -220,21 +232,28 @@ double smooth_cut(const TriMesh& mesh, const VertexStars& stars, std::vector<int
       moved = true;
     }
   }
+  // A chord, an edge inside one side whose two ends are on the cut, has both ends on the
+  // equator and its two faces in one hemisphere: one of them would flip on the sphere. (A face
+  // with three corners on the cut has such an edge.)
   double length = 0;
-  for (int f = 0; f < m; ++f) {
-    if (on_cut(mesh.F(f, 0)) && on_cut(mesh.F(f, 1)) && on_cut(mesh.F(f, 2))) return -1;
+  for (int f = 0; f < m; ++f)
     for (int k = 0; k < 3; ++k) {
       const int g = across(f, k);
-      if (g > f && side[g] != side[f]) length += (mesh.V.row(mesh.F(f, k)) - mesh.V.row(mesh.F(f, (k + 1) % 3))).norm();
+      if (g < f) continue;  // each interior edge once (and boundary edges, which a closed surface has none of)
+      const int a = mesh.F(f, k), b = mesh.F(f, (k + 1) % 3);
+      if (side[g] != side[f])
+        length += (mesh.V.row(a) - mesh.V.row(b)).norm();
+      else if (on_cut(a) && on_cut(b))
+        return -1;
     }
-  }
   return length;
 }
 
 // Cuts a closed genus-0 surface into two topological disks of equal area: the faces on each
-// side of a plane through the area centroid, across its longest principal axis first (a smooth
-// level set, so the cut is one loop on most organs; the other axes are tried next). Returns
-// false when no axis gives two disks.
+// side of a plane through the area centroid across one of its principal axes (a smooth level
+// set, so the cut is one loop on most organs), cleaned up by smooth_cut. The three axes' cuts
+// are tried shortest first: a short cut distorts the two maps least. Returns false when none
+// gives two disks.
 bool split_into_two_disks(const TriMesh& mesh, std::array<Half, 2>& halves, int& axis_used) {
   const int m = mesh.num_faces();
   RowMatrixX3d centroid(m, 3);
@@ -255,7 +274,6 @@ bool split_into_two_disks(const TriMesh& mesh, std::array<Half, 2>& halves, int&
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> principal(covariance);
   const VertexStars stars(mesh.F, mesh.num_vertices());
-  // Each principal plane's cut, shortest first: a short cut distorts the two maps least.
   std::vector<std::pair<double, std::vector<int>>> cuts;
   std::vector<int> axes;
   for (int axis_index = 0; axis_index < 3; ++axis_index) {
@@ -370,11 +388,34 @@ int punctured_sphere_map(const TriMesh& mesh, RowMatrixX3d& domain) {
 bool two_halves_sphere_map(const TriMesh& mesh, RowMatrixX3d& domain, std::vector<int>& cut, nlohmann::json& summary) {
   std::array<Half, 2> halves;
   int axis = -1;
-  if (!split_into_two_disks(mesh, halves, axis)) return false;
+  if (!split_into_two_disks(mesh, halves, axis)) {
+    summary["sphere_map_fallback"] = "no principal plane cuts the surface into two disks";
+    return false;
+  }
   std::array<Eigen::MatrixX2d, 2> xy;
-  run_both([&] { xy[0] = mean_value_disk_map(halves[0].mesh); }, [&] { xy[1] = mean_value_disk_map(halves[1].mesh); });
+  try {
+    run_both([&] { xy[0] = mean_value_disk_map(halves[0].mesh); }, [&] { xy[1] = mean_value_disk_map(halves[1].mesh); });
+  } catch (const AlgorithmError& e) {
+    summary["sphere_map_fallback"] = std::string("a half's map failed: ") + e.what();
+    return false;
+  }
   for (auto& uv : xy) uv = (2.0 * uv.array() - 1.0).matrix();
-  if (!glue_hemispheres(mesh, halves, xy, domain)) return false;
+  if (!glue_hemispheres(mesh, halves, xy, domain)) {
+    summary["sphere_map_fallback"] = "the two halves' maps disagree on the cut";
+    return false;
+  }
+  // Every triangle turned the same way (parameterize() settles which for both maps), none flat.
+  int positive = 0, negative = 0;
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    const double o = domain_orientation(domain.row(mesh.F(f, 0)), domain.row(mesh.F(f, 1)), domain.row(mesh.F(f, 2)));
+    positive += o > 0;
+    negative += o < 0;
+  }
+  const int bad = mesh.num_faces() - std::max(positive, negative);
+  if (bad > 0) {
+    summary["sphere_map_fallback"] = std::to_string(bad) + " triangles flipped or flat on the sphere";
+    return false;
+  }
   std::vector<bool> in_first(mesh.num_vertices(), false);
   for (int v : halves[0].to_surface) in_first[v] = true;
   cut.clear();
@@ -385,6 +426,10 @@ bool two_halves_sphere_map(const TriMesh& mesh, RowMatrixX3d& domain, std::vecto
   return true;
 }
 }  // namespace
+
+double detail::smooth_cut(const TriMesh& mesh, std::vector<int>& side) {
+  return mrsnake::smooth_cut(mesh, VertexStars(mesh.F, mesh.num_vertices()), side);
+}
 
 Eigen::Vector3d mobius_to_center(const Eigen::Vector3d& a, const Eigen::Vector3d& x) {
   const Eigen::Vector3d d = x - a;
@@ -426,13 +471,14 @@ Parameterization parameterize(const TriMesh& input, const ParameterizationOption
       const int pole = punctured_sphere_map(mesh, param.domain);
       param.summary["pole_vertex"] = pole;
     }
+    param.summary["sphere_map"] = param.sphere_map == SphereMap::two_halves ? "two_halves" : "punctured";
     param.summary["solver_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
     int negative = 0;
     for (int f = 0; f < mesh.num_faces(); ++f)
       if (domain_orientation(param.domain.row(mesh.F(f, 0)), param.domain.row(mesh.F(f, 1)),
                              param.domain.row(mesh.F(f, 2))) < 0)
         ++negative;
-    if (2 * negative > mesh.num_faces()) param.domain.col(0) *= -1.0;  // stereographic projection reverses orientation
+    if (2 * negative > mesh.num_faces()) param.domain.col(0) *= -1.0;  // the disk maps' orientation is CGAL's
     balance_iterations = balance_sphere(param.domain, weights);
   }
 

@@ -14,6 +14,8 @@
 ///   arc length, so they agree there). The map is continuous, with a kink along the cut.
 /// Either is then balanced by Möbius transformations until the area-weighted centroid sits at
 /// the centre. No seam in D.
+#include <vector>
+
 #include <nlohmann/json.hpp>
 
 #include "mesh/trimesh.h"
@@ -64,6 +66,16 @@ Parameterization parameterize(const TriMesh& input, const ParameterizationOption
 /// \pre disk is a topological disk without unreferenced vertices.
 /// \throw AlgorithmError if CGAL reports a failure or returns non-finite coordinates.
 Eigen::MatrixX2d mean_value_disk_map(const TriMesh& disk);
+
+namespace detail {
+/// The cut cleanup of the two-halves map, exposed for tests. `side` (0 or 1 per face of a
+/// closed manifold `mesh`) is changed in place: spikes (a side's 3D angle at a cut vertex
+/// below 0.6π and below the other side's) move across, in up to 8 sweeps, then ears (faces
+/// with three corners and two or three edges on the cut) move across.
+/// \return the cut's 3D length, or -1 if a chord is left (an edge inside one side with both ends
+///   on the cut: one of its faces would flip on the sphere).
+double smooth_cut(const TriMesh& mesh, std::vector<int>& side);
+}  // namespace detail
 
 /// The Möbius transformation of the unit sphere that sends the point a (|a| < 1) of the ball
 /// to its centre, applied to the unit vector x.

@@ -445,6 +445,9 @@ void expect_no_flips_on(const std::string& path) {
     o.sphere_map = map;
     o.compute_stats = false;
     const RemeshResult r = remesh(input, o);
+    if (r.domain == "sphere") {
+      EXPECT_EQ(r.parameterization.contains("cut_vertices"), map == SphereMap::two_halves) << path;
+    }
     for (int j = 0; j <= r.connectivity.levels(); ++j) {
       EXPECT_EQ(count_flipped(r.levels[j].domain_positions, r.connectivity.faces[j]), 0) << path << " level " << j;
       EXPECT_EQ(r.levels[j].flipped_triangles, 0);
