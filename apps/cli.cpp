@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <cstdio>
 #include <iostream>
+#include <map>
 
 namespace mrsnake::cli {
 
@@ -22,6 +23,17 @@ void info(const std::string& message) {
 void warn(const std::string& message) { std::cerr << "mrsnake: warning: " << message << '\n'; }
 
 void print_json(const nlohmann::json& j) { std::cout << j.dump(2) << std::endl; }
+
+void add_sphere_map_option(CLI::App& command, SphereMap& map) {
+  command
+      .add_option("--sphere-map", map,
+                  "Closed surfaces: 'auto' (the default: halves from " + std::to_string(ParameterizationOptions{}.halves_from_faces) +
+                      " faces, punctured below), 'halves' (cut in two disks across a principal plane, one solve per core) "
+                      "or 'punctured' (one vertex removed, one solve)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, SphereMap>{
+          {"auto", SphereMap::automatic}, {"halves", SphereMap::two_halves}, {"punctured", SphereMap::punctured}}))
+      ->option_text("auto|halves|punctured");
+}
 
 void refuse_non_finite_numbers(CLI::App& app) {
   const CLI::Validator finite(

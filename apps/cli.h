@@ -8,6 +8,7 @@
 #include <string>
 
 #include "mesh/progress.h"
+#include "remesh/parameterization.h"
 
 namespace mrsnake::cli {
 
@@ -39,6 +40,9 @@ void add_evaluate_command(CLI::App& app);
 void add_remesh_command(CLI::App& app);
 void add_build_model_command(CLI::App& app);
 void add_segment_command(CLI::App& app);
+
+/// Adds --sphere-map auto|halves|punctured (remesh and build-model), bound to `map`.
+void add_sphere_map_option(CLI::App& command, SphereMap& map);
 
 /// Makes every FLOAT option of app and its subcommands refuse nan and inf with a usage error
 /// (CLI11's Range lets nan through: every comparison with it is false). Call after the

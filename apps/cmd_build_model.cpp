@@ -33,6 +33,7 @@ void add_build_model_command(CLI::App& app) {
     double mc_spacing = -1;  // automatic: see --mc-spacing
     bool full_report = false, json = false, compare_unrelaxed = false;
     double reference_margin_mm = 20.0;
+    SphereMap sphere_map = SphereMap::automatic;
   };
   auto a = std::make_shared<Args>();
   cmd->add_option("--labels", a->labels, "Label volume (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)")->required();
@@ -42,6 +43,7 @@ void add_build_model_command(CLI::App& app) {
   auto* faces = cmd->add_option("--faces", a->faces, "Wanted face count of the finest level (default 32768)")
                     ->check(CLI::Range(16, 50000000));
   levels->excludes(faces);
+  add_sphere_map_option(*cmd, a->sphere_map);
   cmd->add_option("--predict", a->predict, "Wavelet predict step: butterfly (default) or linear")
       ->check(CLI::IsMember({"butterfly", "linear"}));
   auto* smooth = cmd->add_option("--smooth", a->smooth,
@@ -125,6 +127,7 @@ void add_build_model_command(CLI::App& app) {
     RemeshOptions ro;
     ro.levels = a->levels;
     ro.target_faces = a->faces;
+    ro.sphere_map = a->sphere_map;
     ro.compute_stats = a->full_report;
     ro.progress = progress;
     const RemeshResult hierarchy = remesh(surface.mesh, ro);

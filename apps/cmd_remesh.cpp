@@ -2,7 +2,6 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
-#include <map>
 #include <optional>
 #include <sstream>
 
@@ -71,13 +70,7 @@ void add_remesh_command(CLI::App& app) {
                   "Finest level: up to this many vertices snap onto the input's vertices farthest from it (default " +
                       std::to_string(RemeshOptions{}.snap_tips) + "; 0 = off; not with --strict or --no-relax)")
       ->check(CLI::Range(0, 100000));
-  cmd->add_option("--sphere-map", args->options.sphere_map,
-                  "Closed inputs: 'auto' (halves from " + std::to_string(ParameterizationOptions{}.halves_from_faces) +
-                      " faces, the default), 'halves' (cut in two disks across a principal plane, solved in parallel) "
-                      "or 'punctured' (one vertex removed, one solve)")
-      ->transform(CLI::CheckedTransformer(std::map<std::string, SphereMap>{{"auto", SphereMap::automatic},
-                                                                            {"halves", SphereMap::two_halves},
-                                                                            {"punctured", SphereMap::punctured}}));
+  add_sphere_map_option(*cmd, args->options.sphere_map);
   cmd->add_option("--iterations", args->options.lloyd_iterations, "Lloyd iterations per level (default 8)")->check(CLI::Range(0, 1000));
   cmd->add_option("--shape-iterations", args->options.shape_iterations,
                   "Iterations per level of 3D shape smoothing after Lloyd (default " + std::to_string(RemeshOptions{}.shape_iterations) + "; not with --strict or --no-relax)")

@@ -62,9 +62,18 @@ TEST(BuildModelCli, BuildsAModelThatModelInfoAccepts) {
   EXPECT_EQ(m.remesh_quality["marching_cubes"]["smoothing_iterations"].get<int>(), 5);
   EXPECT_EQ(m.remesh_quality["marching_cubes"]["faces"].get<int>(), summary["input_faces"].get<int>());
 
+  // A small surface takes the punctured sphere map by default.
+  EXPECT_EQ(m.remesh_quality["parameterization"]["sphere_map"], "punctured");
+
   const auto info = run_mrsnake("model-info --json " + model);
   ASSERT_EQ(info.exit_code, 0) << info.output;
   EXPECT_TRUE(nlohmann::json::parse(info.output)["synthesis"]["ok"].get<bool>());
+
+  // --sphere-map halves reaches the remesher and model.json records it.
+  const std::string halves = (dir / "halves.model").string();
+  const auto built_halves = run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + halves + " --faces 2048 --sphere-map halves");
+  ASSERT_EQ(built_halves.exit_code, 0) << built_halves.output;
+  EXPECT_EQ(load_model(halves, {true}).remesh_quality["parameterization"]["sphere_map"], "two_halves");
 }
 
 TEST(BuildModelCli, McSpacingZeroUsesTheVoxelSurface) {
