@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <exception>
+#include <future>
 #include <system_error>
 #include <thread>
 #include <utility>
@@ -62,6 +63,34 @@ void parallel_ranges(std::size_t n, F&& f, std::size_t min_per_thread = 1024, st
   const std::size_t parts =
       std::max<std::size_t>(1, std::min({hardware, max_threads, n / std::max<std::size_t>(1, min_per_thread)}));
   detail::parallel_ranges_with(n, parts, f, [](auto&& job) { return std::thread(std::move(job)); });
+}
+
+/// Runs a() on the calling thread and b() on another one (one after the other without a second
+/// core or when no thread can be started), and returns after both.
+/// \throw a()'s exception if it threw, else b()'s, after both ended.
+template <class A, class B>
+void run_both_in_parallel(A&& a, B&& b) {
+  std::future<void> other;
+  if (std::thread::hardware_concurrency() > 1) {
+    try {
+      other = std::async(std::launch::async, [&b] { b(); });
+    } catch (const std::system_error&) {
+    }
+  }
+  if (!other.valid()) {
+    a();
+    b();
+    return;
+  }
+  std::exception_ptr error;
+  try {
+    a();
+  } catch (...) {
+    error = std::current_exception();
+  }
+  other.wait();
+  if (error) std::rethrow_exception(error);
+  other.get();
 }
 
 }  // namespace mrsnake

@@ -5,16 +5,14 @@
 #include <cmath>
 #include <complex>
 #include <array>
-#include <future>
 #include <limits>
 #include <numeric>
-#include <system_error>
-#include <thread>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include "mesh/errors.h"
+#include "mesh/parallel.h"
 #include "mesh/topology.h"
 #include "mesh/vertex_stars.h"
 
@@ -128,33 +126,6 @@ Half extract_half(const TriMesh& mesh, const std::vector<int>& faces) {
   for (std::size_t i = 0; i < faces.size(); ++i)
     for (int k = 0; k < 3; ++k) half.mesh.F(static_cast<Eigen::Index>(i), k) = to_half[mesh.F(faces[i], k)];
   return half;
-}
-
-// Runs a() here and b() on another thread (one after the other without a second core or when
-// no thread can be started), and returns after both; rethrows a()'s exception, else b()'s.
-template <class A, class B>
-void run_both(A&& a, B&& b) {
-  std::future<void> other;
-  if (std::thread::hardware_concurrency() > 1) {
-    try {
-      other = std::async(std::launch::async, [&b] { b(); });
-    } catch (const std::system_error&) {
-    }
-  }
-  if (!other.valid()) {
-    a();
-    b();
-    return;
-  }
-  std::exception_ptr error;
-  try {
-    a();
-  } catch (...) {
-    error = std::current_exception();
-  }
-  other.wait();
-  if (error) std::rethrow_exception(error);
-  other.get();
 }
 
 // Cleans up the cut between the faces of side 0 and side 1 (the side of each face, changed in
@@ -302,7 +273,7 @@ bool split_into_two_disks(const TriMesh& mesh, std::array<Half, 2>& halves, int&
     std::array<std::vector<int>, 2> faces;
     for (int f = 0; f < m; ++f) faces[side[f]].push_back(f);
     std::array<bool, 2> disk{};
-    run_both([&] { halves[0] = extract_half(mesh, faces[0]); disk[0] = topology_report(halves[0].mesh).is_disk(); },
+    run_both_in_parallel([&] { halves[0] = extract_half(mesh, faces[0]); disk[0] = topology_report(halves[0].mesh).is_disk(); },
              [&] { halves[1] = extract_half(mesh, faces[1]); disk[1] = topology_report(halves[1].mesh).is_disk(); });
     if (disk[0] && disk[1]) {
       axis_used = axes[c];
@@ -394,7 +365,7 @@ bool two_halves_sphere_map(const TriMesh& mesh, RowMatrixX3d& domain, std::vecto
   }
   std::array<Eigen::MatrixX2d, 2> xy;
   try {
-    run_both([&] { xy[0] = mean_value_disk_map(halves[0].mesh); }, [&] { xy[1] = mean_value_disk_map(halves[1].mesh); });
+    run_both_in_parallel([&] { xy[0] = mean_value_disk_map(halves[0].mesh); }, [&] { xy[1] = mean_value_disk_map(halves[1].mesh); });
   } catch (const AlgorithmError& e) {
     summary["sphere_map_fallback"] = std::string("a half's map failed: ") + e.what();
     return false;

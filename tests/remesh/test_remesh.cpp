@@ -20,6 +20,7 @@
 #include "remesh/lloyd.h"
 #include "remesh/parameterization.h"
 #include "remesh/remesh.h"
+#include "remesh/simplify.h"
 #include "remesh/sizing.h"
 #include "remesh/triangle_repair.h"
 #include "tests/remesh/remesh_shapes.h"
@@ -115,6 +116,32 @@ TEST(Remesh, FineInputIsSimplifiedThenProjectedBackOntoIt) {
   EXPECT_LT(r.parameterization["parameterized_faces"].get<int>(), input.num_faces());
   EXPECT_GE(r.parameterization["parameterized_faces"].get<int>(), 2000);
   expect_nested_and_valid(r, input, true);  // includes: every vertex lies on the original input
+}
+
+// The two-core simplification: each half simplified with the cut between them kept exactly,
+// then stitched. The result must be one closed genus-0 manifold again (no edge made by both
+// halves), near the asked size, and on the input, with the cut's input vertices untouched.
+TEST(Simplify, HalvesStitchBackIntoTheSameTopology) {
+  const TriMesh input = ellipsoid(6);  // 81920 faces
+  SimplifyOptions halves;
+  halves.halves_from_faces = 1000;
+  const TriMesh out = simplify_to_faces(input, 8000, halves);
+  const TopologyReport topo = topology_report(out);
+  EXPECT_TRUE(topo.is_closed_genus0()) << topo.describe();
+  EXPECT_EQ(topo.non_manifold_edges, 0);
+  EXPECT_NEAR(out.num_faces(), 8000, 400);
+  const SurfaceLocator on_input(input);
+  EXPECT_LT(on_input.distances(out.V).maxCoeff(), 0.01);
+  // Many vertices are the input's own, untouched: the cut's.
+  const SurfaceLocator on_output(out);
+  int kept = 0;
+  for (int v = 0; v < input.num_vertices(); ++v) kept += on_output.closest(input.V.row(v).transpose()).distance == 0.0;
+  EXPECT_GT(kept, 100);
+  SimplifyOptions one_core;
+  one_core.halves_from_faces = 0;
+  const TriMesh whole = simplify_to_faces(input, 8000, one_core);
+  EXPECT_TRUE(topology_report(whole).is_closed_genus0());
+  EXPECT_NEAR(whole.num_faces(), 8000, 20);
 }
 
 TEST(Remesh, StrictModeKeepsCoarseVerticesInTheDomain) {
