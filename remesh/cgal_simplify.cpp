@@ -9,16 +9,27 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <cstring>
-#include <unordered_map>
+#include <map>
+#include <numeric>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include "mesh/errors.h"
 #include "mesh/parallel.h"
+#include "mesh/topology.h"
+#include "mesh/vertex_stars.h"
+#include "remesh/domain.h"
 #include "remesh/simplify.h"
 
 namespace mrsnake {
 namespace {
+
+// The halves stop this much above their share of the target; the last pass over the stitched
+// surface takes the rest, the cut's strip of input-sized edges first (the shortest).
+constexpr double kHalvesSlack = 1.05;
 
 using Kernel = CGAL::Simple_cartesian<double>;
 using Point_3 = Kernel::Point_3;
@@ -29,7 +40,7 @@ namespace SMS = CGAL::Surface_mesh_simplification;
 // Midpoint placement that never moves a boundary vertex: an edge with one end on the boundary
 // collapses onto that end, an edge with both ends on it does not collapse, and neither does
 // one that would join two boundary vertices by a new edge (the other half could make the same
-// edge: three faces on it once stitched). A boundary vertex is one topologically (CGAL keeps
+// edge: four faces on it once stitched). A boundary vertex is one topologically (CGAL keeps
 // that through every collapse), so a half's cut stays exactly where it was, to be stitched to
 // the other half's.
 class KeepBoundaryPlacement {
@@ -84,19 +95,23 @@ void collapse_to_edges(SurfaceMesh& sm, std::size_t edges, const Placement& inne
   sm.collect_garbage();
 }
 
-// Appends sm's vertices and faces to `out`; vertices found in `shared` (by exact position) are
-// not added again.
-void append(const SurfaceMesh& sm, std::vector<std::array<double, 3>>& points, std::vector<std::array<int, 3>>& faces,
-            std::unordered_map<std::string, int>* shared) {
+// Appends sm's vertices and faces to `points` and `faces`. With `shared`, a boundary vertex at
+// the exact position of a boundary vertex of the other half is that vertex (its bits are the
+// key: both halves copied them from the same input vertex). Returns false if one half has two
+// boundary vertices at one position (the stitch would be ambiguous).
+bool append(const SurfaceMesh& sm, std::vector<std::array<double, 3>>& points, std::vector<std::array<int, 3>>& faces,
+            std::map<std::array<std::uint64_t, 3>, std::pair<int, int>>* shared, int half) {
   std::vector<int> index(sm.num_vertices(), -1);
   for (const auto v : sm.vertices()) {
     const Point_3& p = sm.point(v);
     const std::array<double, 3> xyz{p.x(), p.y(), p.z()};
     if (shared && static_cast<bool>(CGAL::is_border(v, sm))) {
-      std::string key(reinterpret_cast<const char*>(xyz.data()), sizeof xyz);
-      const auto [it, inserted] = shared->emplace(std::move(key), static_cast<int>(points.size()));
+      std::array<std::uint64_t, 3> key{};
+      std::memcpy(key.data(), xyz.data(), sizeof key);
+      const auto [it, inserted] = shared->emplace(key, std::make_pair(static_cast<int>(points.size()), half));
       if (!inserted) {
-        index[v.idx()] = it->second;
+        if (it->second.second == half) return false;
+        index[v.idx()] = it->second.first;
         continue;
       }
     }
@@ -113,6 +128,7 @@ void append(const SurfaceMesh& sm, std::vector<std::array<double, 3>>& points, s
     if (k != 3) throw AlgorithmError("the simplified surface has a non-triangular face");
     faces.push_back(corners);
   }
+  return true;
 }
 
 TriMesh to_trimesh(const std::vector<std::array<double, 3>>& points, const std::vector<std::array<int, 3>>& faces) {
@@ -126,41 +142,70 @@ TriMesh to_trimesh(const std::vector<std::array<double, 3>>& points, const std::
 
 }  // namespace
 
-TriMesh simplify_to_faces(const TriMesh& mesh, int target_faces, const SimplifyOptions& options) {
+std::optional<TriMesh> detail::simplify_in_halves(const TriMesh& mesh, int target_faces) {
+  // Two halves across the bounding box's longest axis (faces by centroid, at the median),
+  // each simplified on its own core with its cut kept exactly, then stitched along it.
   const int m = mesh.num_faces();
+  const Eigen::RowVector3d extent = mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff();
+  Eigen::Index axis = 0;
+  extent.maxCoeff(&axis);
+  std::vector<double> height(m);
+  for (int f = 0; f < m; ++f) height[f] = mesh.V(mesh.F(f, 0), axis) + mesh.V(mesh.F(f, 1), axis) + mesh.V(mesh.F(f, 2), axis);
+  std::vector<int> order(m);
+  std::iota(order.begin(), order.end(), 0);
+  std::nth_element(order.begin(), order.begin() + m / 2, order.end(), [&](int a, int b) { return height[a] < height[b]; });
+  const std::array<std::vector<int>, 2> half{std::vector<int>(order.begin(), order.begin() + m / 2),
+                                             std::vector<int>(order.begin() + m / 2, order.end())};
+  std::array<SurfaceMesh, 2> sm;
+  const auto simplify_half = [&](int i) {
+    sm[i] = to_surface_mesh(mesh, half[i]);
+    std::size_t border = 0;
+    for (const auto h : sm[i].halfedges()) border += sm[i].is_border(h);
+    // Edges of a triangle mesh with B boundary edges: (3F + B) / 2.
+    const double share = static_cast<double>(half[i].size()) / m;
+    collapse_to_edges(sm[i], static_cast<std::size_t>(share * kHalvesSlack * target_faces * 1.5 + 0.5 * border),
+                      KeepBoundaryPlacement());
+  };
+  run_both_in_parallel([&] { simplify_half(0); }, [&] { simplify_half(1); });
   std::vector<std::array<double, 3>> points;
   std::vector<std::array<int, 3>> faces;
-  if (options.halves_from_faces > 0 && m >= options.halves_from_faces) {
-    // Two halves across the bounding box's longest axis (faces by centroid, at the median),
-    // each simplified on its own core with its cut kept exactly, then stitched along it.
-    const Eigen::RowVector3d extent = mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff();
-    Eigen::Index axis = 0;
-    extent.maxCoeff(&axis);
-    std::vector<double> height(m);
-    for (int f = 0; f < m; ++f) height[f] = mesh.V(mesh.F(f, 0), axis) + mesh.V(mesh.F(f, 1), axis) + mesh.V(mesh.F(f, 2), axis);
-    std::vector<int> order(m);
-    for (int f = 0; f < m; ++f) order[f] = f;
-    std::nth_element(order.begin(), order.begin() + m / 2, order.end(), [&](int a, int b) { return height[a] < height[b]; });
-    std::array<std::vector<int>, 2> half{std::vector<int>(order.begin(), order.begin() + m / 2),
-                                         std::vector<int>(order.begin() + m / 2, order.end())};
-    std::array<SurfaceMesh, 2> sm;
-    const auto simplify_half = [&](int i) {
-      sm[i] = to_surface_mesh(mesh, half[i]);
-      // Edges of a triangle mesh with a boundary: about 3F/2.
-      const double share = static_cast<double>(half[i].size()) / m;
-      collapse_to_edges(sm[i], static_cast<std::size_t>(share * target_faces * 1.5), KeepBoundaryPlacement());
-    };
-    run_both_in_parallel([&] { simplify_half(0); }, [&] { simplify_half(1); });
-    std::unordered_map<std::string, int> cut;
-    append(sm[0], points, faces, &cut);
-    append(sm[1], points, faces, &cut);
-  } else {
-    std::vector<int> all(m);
-    for (int f = 0; f < m; ++f) all[f] = f;
-    SurfaceMesh whole = to_surface_mesh(mesh, all);
-    collapse_to_edges(whole, static_cast<std::size_t>(target_faces) * 3 / 2, SMS::Midpoint_placement<SurfaceMesh>());
-    append(whole, points, faces, nullptr);
-  }
+  std::map<std::array<std::uint64_t, 3>, std::pair<int, int>> cut;  // position -> vertex, half
+  if (!append(sm[0], points, faces, &cut, 0) || !append(sm[1], points, faces, &cut, 1)) return std::nullopt;
+  const TriMesh stitched = to_trimesh(points, faces);
+  // The same closed surface: V - E + F with E = 3F / 2, over the referenced vertices.
+  std::vector<bool> used(mesh.num_vertices(), false);
+  for (int f = 0; f < m; ++f)
+    for (int k = 0; k < 3; ++k) used[mesh.F(f, k)] = true;
+  const int euler = static_cast<int>(std::count(used.begin(), used.end(), true)) - m / 2;
+  const TopologyReport after = topology_report(stitched);
+  if (!(after.is_manifold() && after.is_closed() && after.components == 1 && after.euler_characteristic == euler))
+    return std::nullopt;
+  // The last pass over the whole surface: the cut's strip of input-sized edges (the shortest)
+  // goes first.
+  std::vector<int> all(stitched.num_faces());
+  std::iota(all.begin(), all.end(), 0);
+  SurfaceMesh whole = to_surface_mesh(stitched, all);
+  collapse_to_edges(whole, static_cast<std::size_t>(target_faces) * 3 / 2, SMS::Midpoint_placement<SurfaceMesh>());
+  points.clear();
+  faces.clear();
+  append(whole, points, faces, nullptr, 0);
+  return to_trimesh(points, faces);
+}
+
+TriMesh simplify_to_faces(const TriMesh& mesh, int target_faces, const SimplifyOptions& options) {
+  // Halves only for a closed surface: a disk's own rim would be kept whole too.
+  if (options.halves_from_faces > 0 && mesh.num_faces() >= options.halves_from_faces &&
+      boundary_edges(mesh.F, VertexStars(mesh.F, mesh.num_vertices())).empty())
+    if (std::optional<TriMesh> halves = detail::simplify_in_halves(mesh, target_faces)) return std::move(*halves);
+  // One core (also when the halves did not stitch: repeated positions on the cut, or a
+  // zero-length edge that CGAL collapsed without asking the placement).
+  std::vector<int> all(mesh.num_faces());
+  std::iota(all.begin(), all.end(), 0);
+  SurfaceMesh whole = to_surface_mesh(mesh, all);
+  collapse_to_edges(whole, static_cast<std::size_t>(target_faces) * 3 / 2, SMS::Midpoint_placement<SurfaceMesh>());
+  std::vector<std::array<double, 3>> points;
+  std::vector<std::array<int, 3>> faces;
+  append(whole, points, faces, nullptr, 0);
   return to_trimesh(points, faces);
 }
 
