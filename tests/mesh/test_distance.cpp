@@ -149,6 +149,22 @@ TEST(ParallelRanges, ARangeWhoseThreadCannotStartRunsOnTheCaller) {
   for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(hits[i].load(), 1) << "index " << i;
 }
 
+// Both jobs run, whichever throws; a()'s exception wins, and b()'s is not lost when a() succeeds.
+TEST(ParallelRanges, RunBothRunsBothAndRethrowsAFirst) {
+  std::atomic<int> ran{0};
+  run_both_in_parallel([&] { ++ran; }, [&] { ++ran; });
+  EXPECT_EQ(ran.load(), 2);
+  ran = 0;
+  try {
+    run_both_in_parallel([&] { ++ran; throw std::runtime_error("a"); }, [&] { ++ran; throw std::logic_error("b"); });
+    ADD_FAILURE() << "nothing thrown";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "a");
+  }
+  EXPECT_EQ(ran.load(), 2);
+  EXPECT_THROW(run_both_in_parallel([] {}, [] { throw std::logic_error("b"); }), std::logic_error);
+}
+
 TEST(SurfaceDistance, MeshAgainstItselfIsZero) {
   const TriMesh sphere = icosphere(3, 4.0);
   const SurfaceDistance d = surface_distance(sphere, sphere);

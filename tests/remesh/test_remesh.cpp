@@ -20,7 +20,6 @@
 #include "remesh/lloyd.h"
 #include "remesh/parameterization.h"
 #include "remesh/remesh.h"
-#include "remesh/simplify.h"
 #include "remesh/sizing.h"
 #include "remesh/triangle_repair.h"
 #include "tests/remesh/remesh_shapes.h"
@@ -116,30 +115,6 @@ TEST(Remesh, FineInputIsSimplifiedThenProjectedBackOntoIt) {
   EXPECT_LT(r.parameterization["parameterized_faces"].get<int>(), input.num_faces());
   EXPECT_GE(r.parameterization["parameterized_faces"].get<int>(), 2000);
   expect_nested_and_valid(r, input, true);  // includes: every vertex lies on the original input
-}
-
-// The two-core simplification: each half simplified with the cut between them kept exactly,
-// then stitched and finished over the whole. The halves must stitch back into one closed
-// genus-0 manifold (no edge made by both halves: without the guard against new edges between
-// cut vertices, 57 edges had four faces), near the asked size, on the input.
-TEST(Simplify, HalvesStitchBackIntoTheSameTopology) {
-  const TriMesh input = ellipsoid(6);  // 81920 faces
-  const std::optional<TriMesh> out = detail::simplify_in_halves(input, 8000);
-  ASSERT_TRUE(out.has_value()) << "the halves did not stitch";
-  const TopologyReport topo = topology_report(*out);
-  EXPECT_TRUE(topo.is_closed_genus0()) << topo.describe();
-  EXPECT_NEAR(out->num_faces(), 8000, 20);
-  const SurfaceLocator on_input(input);
-  EXPECT_LT(on_input.distances(out->V).maxCoeff(), 0.01);
-  // simplify_to_faces takes this path from halves_from_faces on, one core below: both keep the
-  // topology and the size.
-  for (int from : {1000, 0}) {
-    SimplifyOptions options;
-    options.halves_from_faces = from;
-    const TriMesh again = simplify_to_faces(input, 8000, options);
-    EXPECT_TRUE(topology_report(again).is_closed_genus0()) << from;
-    EXPECT_NEAR(again.num_faces(), 8000, 20) << from;
-  }
 }
 
 TEST(Remesh, StrictModeKeepsCoarseVerticesInTheDomain) {
