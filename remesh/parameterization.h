@@ -39,8 +39,9 @@ enum class SphereMap {
 struct ParameterizationOptions {
   SphereMap sphere_map = SphereMap::automatic;
   /// With automatic: the face count from which the two-halves map is used. On the 179k-face
-  /// liver it takes 0.46 s instead of 0.84 s; on the 28k-face bear both take 0.1 s and the
-  /// punctured map's triangles come out slightly better (docs/bench-build-model.md).
+  /// liver its solve takes 0.55 s instead of 0.87 s; on the 28k-face bear both take 0.1 s, and
+  /// on the small benchmark meshes the punctured map's worst triangles come out better
+  /// (docs/bench-build-model.md, session 5).
   int halves_from_faces = 100000;
 };
 
