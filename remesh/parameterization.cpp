@@ -1,10 +1,10 @@
 #include "remesh/parameterization.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <complex>
-#include <array>
 #include <limits>
 #include <numeric>
 
@@ -101,27 +101,27 @@ int balance_disk(RowMatrixX3d& D, const Eigen::VectorXd& weights) {
   return it;
 }
 
-
-// One half of a closed surface cut in two: its faces as a mesh of its own, and where its
-// vertices come from.
-struct Half {
+// Some faces of a surface as a mesh of their own (a half of a closed surface cut in two, or
+// the punctured surface), and where its vertices come from.
+struct Piece {
   TriMesh mesh;
   std::vector<int> to_surface;  ///< half vertex -> surface vertex
 };
 
-Half extract_half(const TriMesh& mesh, const std::vector<int>& faces) {
+Piece extract_piece(const TriMesh& mesh, const std::vector<int>& faces) {
   // Vertices keep their relative order (as remove_unreferenced_vertices does).
   std::vector<int> to_half(mesh.num_vertices(), -1);
   for (int f : faces)
     for (int k = 0; k < 3; ++k) to_half[mesh.F(f, k)] = 0;
-  Half half;
+  Piece half;
   for (int v = 0; v < mesh.num_vertices(); ++v)
     if (to_half[v] == 0) {
       to_half[v] = static_cast<int>(half.to_surface.size());
       half.to_surface.push_back(v);
     }
   half.mesh.V.resize(static_cast<Eigen::Index>(half.to_surface.size()), 3);
-  for (std::size_t h = 0; h < half.to_surface.size(); ++h) half.mesh.V.row(static_cast<Eigen::Index>(h)) = mesh.V.row(half.to_surface[h]);
+  for (std::size_t h = 0; h < half.to_surface.size(); ++h)
+    half.mesh.V.row(static_cast<Eigen::Index>(h)) = mesh.V.row(half.to_surface[h]);
   half.mesh.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
   for (std::size_t i = 0; i < faces.size(); ++i)
     for (int k = 0; k < 3; ++k) half.mesh.F(static_cast<Eigen::Index>(i), k) = to_half[mesh.F(faces[i], k)];
@@ -161,7 +161,8 @@ double smooth_cut(const TriMesh& mesh, const VertexStars& stars, std::vector<int
   RowMatrixX3d corner(m, 3);
   for (int f = 0; f < m; ++f)
     for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d p = mesh.V.row(mesh.F(f, k)), a = mesh.V.row(mesh.F(f, (k + 1) % 3)), b = mesh.V.row(mesh.F(f, (k + 2) % 3));
+      const Eigen::Vector3d p = mesh.V.row(mesh.F(f, k)), a = mesh.V.row(mesh.F(f, (k + 1) % 3)),
+                            b = mesh.V.row(mesh.F(f, (k + 2) % 3));
       corner(f, k) = std::atan2((a - p).cross(b - p).norm(), (a - p).dot(b - p));
       angle[mesh.F(f, k)][side[f]] += corner(f, k);
     }
@@ -225,7 +226,7 @@ double smooth_cut(const TriMesh& mesh, const VertexStars& stars, std::vector<int
 // set, so the cut is one loop on most organs), cleaned up by smooth_cut. The three axes' cuts
 // are tried shortest first: a short cut distorts the two maps least. Returns false when none
 // gives two disks.
-bool split_into_two_disks(const TriMesh& mesh, std::array<Half, 2>& halves, int& axis_used) {
+bool split_into_two_disks(const TriMesh& mesh, std::array<Piece, 2>& halves, int& axis_used) {
   const int m = mesh.num_faces();
   RowMatrixX3d centroid(m, 3);
   Eigen::VectorXd area(m);
@@ -273,8 +274,11 @@ bool split_into_two_disks(const TriMesh& mesh, std::array<Half, 2>& halves, int&
     std::array<std::vector<int>, 2> faces;
     for (int f = 0; f < m; ++f) faces[side[f]].push_back(f);
     std::array<bool, 2> disk{};
-    run_both_in_parallel([&] { halves[0] = extract_half(mesh, faces[0]); disk[0] = topology_report(halves[0].mesh).is_disk(); },
-             [&] { halves[1] = extract_half(mesh, faces[1]); disk[1] = topology_report(halves[1].mesh).is_disk(); });
+    const auto extract = [&](int i) {
+      halves[i] = extract_piece(mesh, faces[i]);
+      disk[i] = topology_report(halves[i].mesh).is_disk();
+    };
+    run_both_in_parallel([&] { extract(0); }, [&] { extract(1); });
     if (disk[0] && disk[1]) {
       axis_used = axes[c];
       return true;
@@ -297,13 +301,14 @@ double signed_area(const Eigen::MatrixX2d& xy, const RowMatrixX3i& F) {
 // hemisphere, half 1 onto the southern, each by inverse stereographic projection, the cut on
 // the equator. Both disks put the cut on the unit circle by arc length, so they agree there
 // up to a rotation and a reflection, which are undone here. Returns false if they do not agree.
-bool glue_hemispheres(const TriMesh& mesh, const std::array<Half, 2>& halves, std::array<Eigen::MatrixX2d, 2> xy,
+bool glue_hemispheres(const TriMesh& mesh, const std::array<Piece, 2>& halves, std::array<Eigen::MatrixX2d, 2> xy,
                       RowMatrixX3d& domain) {
   // Half 0 counter-clockwise (outward on the north), half 1 clockwise (outward on the south).
   for (int i = 0; i < 2; ++i)
     if ((signed_area(xy[i], halves[i].mesh.F) < 0) == (i == 0)) xy[i].col(1) *= -1.0;
   std::vector<int> cut_position(mesh.num_vertices(), -1);  // surface vertex -> row of half 0
-  for (std::size_t h = 0; h < halves[0].to_surface.size(); ++h) cut_position[halves[0].to_surface[h]] = static_cast<int>(h);
+  for (std::size_t h = 0; h < halves[0].to_surface.size(); ++h)
+    cut_position[halves[0].to_surface[h]] = static_cast<int>(h);
   // The rotation taking half 1's circle onto half 0's, from one shared vertex.
   double rotation = 0;
   bool found = false;
@@ -341,7 +346,7 @@ int punctured_sphere_map(const TriMesh& mesh, RowMatrixX3d& domain) {
   std::vector<int> keep;
   for (int f = 0; f < mesh.num_faces(); ++f)
     if (mesh.F(f, 0) != pole && mesh.F(f, 1) != pole && mesh.F(f, 2) != pole) keep.push_back(f);
-  const Half disk = extract_half(mesh, keep);
+  const Piece disk = extract_piece(mesh, keep);
   const Eigen::MatrixX2d uv = mean_value_disk_map(disk.mesh);
   domain.resize(n, 3);
   for (std::size_t i = 0; i < disk.to_surface.size(); ++i) {
@@ -357,7 +362,7 @@ int punctured_sphere_map(const TriMesh& mesh, RowMatrixX3d& domain) {
 // core, then glued along the cut onto the sphere. Returns false (and leaves the outputs
 // unspecified) when no principal plane cuts the surface into two disks.
 bool two_halves_sphere_map(const TriMesh& mesh, RowMatrixX3d& domain, std::vector<int>& cut, nlohmann::json& summary) {
-  std::array<Half, 2> halves;
+  std::array<Piece, 2> halves;
   int axis = -1;
   if (!split_into_two_disks(mesh, halves, axis)) {
     summary["sphere_map_fallback"] = "no principal plane cuts the surface into two disks";
@@ -365,7 +370,8 @@ bool two_halves_sphere_map(const TriMesh& mesh, RowMatrixX3d& domain, std::vecto
   }
   std::array<Eigen::MatrixX2d, 2> xy;
   try {
-    run_both_in_parallel([&] { xy[0] = mean_value_disk_map(halves[0].mesh); }, [&] { xy[1] = mean_value_disk_map(halves[1].mesh); });
+    run_both_in_parallel([&] { xy[0] = mean_value_disk_map(halves[0].mesh); },
+                         [&] { xy[1] = mean_value_disk_map(halves[1].mesh); });
   } catch (const AlgorithmError& e) {
     summary["sphere_map_fallback"] = std::string("a half's map failed: ") + e.what();
     return false;
@@ -396,6 +402,7 @@ bool two_halves_sphere_map(const TriMesh& mesh, RowMatrixX3d& domain, std::vecto
   summary["cut_vertices"] = static_cast<int>(cut.size());
   return true;
 }
+
 }  // namespace
 
 double detail::smooth_cut(const TriMesh& mesh, std::vector<int>& side) {
@@ -436,8 +443,8 @@ Parameterization parameterize(const TriMesh& input, const ParameterizationOption
     const bool halves = options.sphere_map == SphereMap::two_halves ||
                         (options.sphere_map == SphereMap::automatic && mesh.num_faces() >= options.halves_from_faces);
     const auto solve_start = std::chrono::steady_clock::now();
-    param.sphere_map = halves && two_halves_sphere_map(mesh, param.domain, param.cut, param.summary) ? SphereMap::two_halves
-                                                                                                    : SphereMap::punctured;
+    const bool cut = halves && two_halves_sphere_map(mesh, param.domain, param.cut, param.summary);
+    param.sphere_map = cut ? SphereMap::two_halves : SphereMap::punctured;
     if (param.sphere_map == SphereMap::punctured) {
       const int pole = punctured_sphere_map(mesh, param.domain);
       param.summary["pole_vertex"] = pole;
