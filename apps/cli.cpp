@@ -9,6 +9,8 @@
 #include <iostream>
 #include <map>
 
+#include "remesh/parameterization.h"
+
 namespace mrsnake::cli {
 
 GlobalOptions& global_options() {

@@ -8,7 +8,10 @@
 #include <string>
 
 #include "mesh/progress.h"
-#include "remesh/parameterization.h"
+
+namespace mrsnake {
+enum class SphereMap;  // remesh/parameterization.h
+}  // namespace mrsnake
 
 namespace mrsnake::cli {
 

@@ -121,7 +121,8 @@ void add_build_model_command(CLI::App& app) {
     lap("marching_cubes");
 
     // The report page measures every level against the input: its tree is built on the
-    // other core while the (single-threaded) parameterization solve runs.
+    // other core while the parameterization solve runs (single-threaded with the punctured
+    // map; the two-halves map uses both cores, and the tree then shares them).
     std::future<std::unique_ptr<SurfaceLocator>> input_locator = std::async(
         std::launch::async, [&surface] { return std::make_unique<SurfaceLocator>(surface.mesh); });
     RemeshOptions ro;

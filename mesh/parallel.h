@@ -1,7 +1,8 @@
 #pragma once
 /// \file parallel.h
-/// A minimal fork-join loop over index ranges (std::thread), for loops whose iterations are
-/// independent: the results do not depend on the number of threads.
+/// Minimal fork-join helpers (std::thread): a loop over index ranges, for loops whose
+/// iterations are independent (the results do not depend on the number of threads), and two
+/// jobs side by side.
 #include <algorithm>
 #include <cstddef>
 #include <exception>
@@ -77,16 +78,20 @@ void run_both_in_parallel(A&& a, B&& b) {
     } catch (...) {  // std::system_error (no thread) or std::bad_alloc: run b() here after a()
     }
   }
-  if (!other.valid()) {
-    a();
-    b();
-    return;
-  }
   std::exception_ptr error;
   try {
     a();
   } catch (...) {
     error = std::current_exception();
+  }
+  if (!other.valid()) {  // b() here, even when a() threw
+    try {
+      b();
+    } catch (...) {
+      if (!error) error = std::current_exception();
+    }
+    if (error) std::rethrow_exception(error);
+    return;
   }
   other.wait();
   if (error) std::rethrow_exception(error);

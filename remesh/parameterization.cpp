@@ -105,27 +105,27 @@ int balance_disk(RowMatrixX3d& D, const Eigen::VectorXd& weights) {
 // the punctured surface), and where its vertices come from.
 struct Piece {
   TriMesh mesh;
-  std::vector<int> to_surface;  ///< half vertex -> surface vertex
+  std::vector<int> to_surface;  ///< piece vertex -> surface vertex
 };
 
 Piece extract_piece(const TriMesh& mesh, const std::vector<int>& faces) {
   // Vertices keep their relative order (as remove_unreferenced_vertices does).
-  std::vector<int> to_half(mesh.num_vertices(), -1);
+  std::vector<int> to_piece(mesh.num_vertices(), -1);
   for (int f : faces)
-    for (int k = 0; k < 3; ++k) to_half[mesh.F(f, k)] = 0;
-  Piece half;
+    for (int k = 0; k < 3; ++k) to_piece[mesh.F(f, k)] = 0;
+  Piece piece;
   for (int v = 0; v < mesh.num_vertices(); ++v)
-    if (to_half[v] == 0) {
-      to_half[v] = static_cast<int>(half.to_surface.size());
-      half.to_surface.push_back(v);
+    if (to_piece[v] == 0) {
+      to_piece[v] = static_cast<int>(piece.to_surface.size());
+      piece.to_surface.push_back(v);
     }
-  half.mesh.V.resize(static_cast<Eigen::Index>(half.to_surface.size()), 3);
-  for (std::size_t h = 0; h < half.to_surface.size(); ++h)
-    half.mesh.V.row(static_cast<Eigen::Index>(h)) = mesh.V.row(half.to_surface[h]);
-  half.mesh.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+  piece.mesh.V.resize(static_cast<Eigen::Index>(piece.to_surface.size()), 3);
+  for (std::size_t h = 0; h < piece.to_surface.size(); ++h)
+    piece.mesh.V.row(static_cast<Eigen::Index>(h)) = mesh.V.row(piece.to_surface[h]);
+  piece.mesh.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
   for (std::size_t i = 0; i < faces.size(); ++i)
-    for (int k = 0; k < 3; ++k) half.mesh.F(static_cast<Eigen::Index>(i), k) = to_half[mesh.F(faces[i], k)];
-  return half;
+    for (int k = 0; k < 3; ++k) piece.mesh.F(static_cast<Eigen::Index>(i), k) = to_piece[mesh.F(faces[i], k)];
+  return piece;
 }
 
 // Cleans up the cut between the faces of side 0 and side 1 (the side of each face, changed in
@@ -359,8 +359,9 @@ int punctured_sphere_map(const TriMesh& mesh, RowMatrixX3d& domain) {
 }
 
 // The two-halves map: the surface cut into two disks, each mapped to the unit disk on its own
-// core, then glued along the cut onto the sphere. Returns false (and leaves the outputs
-// unspecified) when no principal plane cuts the surface into two disks.
+// core, then glued along the cut onto the sphere. Returns false (and leaves `domain`
+// unspecified, `summary["sphere_map_fallback"]` saying why) when no principal plane cuts the
+// surface into two disks, a half's solve fails, or a triangle flips or goes flat.
 bool two_halves_sphere_map(const TriMesh& mesh, RowMatrixX3d& domain, std::vector<int>& cut, nlohmann::json& summary) {
   std::array<Piece, 2> halves;
   int axis = -1;
@@ -450,6 +451,7 @@ Parameterization parameterize(const TriMesh& input, const ParameterizationOption
       param.summary["pole_vertex"] = pole;
     }
     param.summary["sphere_map"] = param.sphere_map == SphereMap::two_halves ? "two_halves" : "punctured";
+    // The sphere map's whole time: the cut search or the puncture, and the solve(s).
     param.summary["solver_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
     int negative = 0;
     for (int f = 0; f < mesh.num_faces(); ++f)

@@ -31,16 +31,18 @@ enum class SphereMap {
   /// One vertex's star removed, the rest mapped to one disk: one sparse solve.
   punctured,
   /// Cut in two disks of equal area across a principal plane, one per hemisphere: two
-  /// half-size solves, in parallel (falls back to punctured when no principal plane cuts the
-  /// surface into two disks).
+  /// half-size solves, in parallel. Falls back to punctured when no principal plane cuts the
+  /// surface into two disks, a half's solve fails, or a triangle flips or goes flat on the
+  /// sphere (the summary's `sphere_map_fallback` says which).
   two_halves
 };
 
 struct ParameterizationOptions {
   SphereMap sphere_map = SphereMap::automatic;
   /// With automatic: the face count from which the two-halves map is used. On the 179k-face
-  /// liver its solve takes 0.55 s instead of 0.87 s; on the 28k-face bear both take 0.1 s, and
-  /// on the small benchmark meshes the punctured map's worst triangles come out better
+  /// liver its solve takes 0.55 s instead of 0.87 s; on the small benchmark meshes (4k-28k
+  /// faces) the whole remeshing takes about as long either way, and the punctured map's worst
+  /// triangles come out better on bear, blobby and retinal, worse on heart
   /// (docs/bench-build-model.md, session 5).
   int halves_from_faces = 100000;
 };
@@ -53,7 +55,7 @@ struct Parameterization {
   RowMatrixX3d domain;             ///< position in D of each vertex of `surface`
   Eigen::VectorXd face_stretch;    ///< per face: A3D / A_D (the inverse of the paper's distortion d)
   Eigen::VectorXd vertex_stretch;  ///< per vertex: sum of incident A3D / sum of incident A_D
-  std::vector<int> cut;            ///< with two_halves: the surface vertices on the cut (the equator of D)
+  std::vector<int> cut;            ///< with two_halves: the surface vertices on the cut, by index (they lie on one circle of D)
   nlohmann::json summary;          ///< method, distortion range, seconds
 };
 
@@ -73,8 +75,10 @@ namespace detail {
 /// closed manifold `mesh`) is changed in place: spikes (a side's 3D angle at a cut vertex
 /// below 0.6π and below the other side's) move across, in up to 8 sweeps, then ears (faces
 /// with three corners and two or three edges on the cut) move across.
-/// \return the cut's 3D length, or -1 if a chord is left (an edge inside one side with both ends
-///   on the cut: one of its faces would flip on the sphere).
+/// \pre `mesh` is a closed, consistently oriented manifold; `side` has one entry, 0 or 1, per face.
+/// \return the cut's 3D length; 0 if the moves emptied one side (no cut left); or -1 if a chord
+///   is left (an edge inside one side with both ends on the cut: one of its faces would flip on
+///   the sphere).
 double smooth_cut(const TriMesh& mesh, std::vector<int>& side);
 }  // namespace detail
 

@@ -1,5 +1,6 @@
-// The mean value parameterization's sparse solve (remesh/cgal_mean_value.cpp): whatever the
-// ordering and factorization, the disk map must solve Floater's mean value system.
+// The mean value parameterization (remesh/cgal_mean_value.cpp, remesh/parameterization.cpp):
+// whatever the ordering and factorization, the disk map must solve Floater's mean value system;
+// the two-halves sphere map must glue its halves into an embedding with a clean cut.
 #include <gtest/gtest.h>
 
 #include <Eigen/SVD>
@@ -139,21 +140,27 @@ TEST(SphereMap, TwoHalvesGlueAlongOneCircleOfTheSphereWithoutFlips) {
   EXPECT_LT((centred * normal).cwiseAbs().maxCoeff(), 1e-9);
   EXPECT_GT(svd.singularValues()[1], 0.1 * svd.singularValues()[0]);  // a circle, not a few points on a line
 
-  // The cut's plane splits the surface's vertices into the two halves: every vertex off the
-  // cut is on one side of it, half the area on each (the cut is at the median).
+  // The cut's plane splits the surface into the two halves: no face has corners strictly on
+  // both sides of it, and each side holds half the area (the cut is at the median).
   const Eigen::VectorXd side = (p.domain.rowwise() - centre) * normal;
   double area_above = 0, area_total = 0;
   for (int f = 0; f < p.surface.num_faces(); ++f) {
     const Eigen::Vector3d a = p.surface.V.row(p.surface.F(f, 0)), b = p.surface.V.row(p.surface.F(f, 1)),
                           c = p.surface.V.row(p.surface.F(f, 2));
     const double area = 0.5 * (b - a).cross(c - a).norm();
-    const double s = side[p.surface.F(f, 0)] + side[p.surface.F(f, 1)] + side[p.surface.F(f, 2)];
+    double highest = -1, lowest = 1;
+    for (int k = 0; k < 3; ++k) {
+      highest = std::max(highest, side[p.surface.F(f, k)]);
+      lowest = std::min(lowest, side[p.surface.F(f, k)]);
+    }
+    EXPECT_FALSE(highest > 1e-9 && lowest < -1e-9) << "face " << f << " straddles the cut";
     area_total += area;
-    if (s > 0) area_above += area;
+    if (highest > 1e-9) area_above += area;
   }
   EXPECT_NEAR(area_above / area_total, 0.5, 0.02);
-
 }
+
+namespace {
 
 // Vertices on the cut where one side's 3D angle is below 0.6π (the disk maps open it to π).
 int count_spikes(const TriMesh& mesh, const std::vector<int>& side) {
@@ -169,6 +176,8 @@ int count_spikes(const TriMesh& mesh, const std::vector<int>& side) {
     if (a[0] > 0 && a[1] > 0 && std::min(a[0], a[1]) < 0.6 * M_PI) ++spikes;
   return spikes;
 }
+
+}  // namespace
 
 // A plane cut along the edges of an uneven mesh (a sphere's, its vertices jittered like a
 // marching-cubes surface's) zigzags: spikes of one or two triangles. The cleanup must remove
