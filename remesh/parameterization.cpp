@@ -138,7 +138,20 @@ Piece extract_piece(const TriMesh& mesh, const std::vector<int>& faces) {
 //   equator), move to the other side, one at a time; each move shortens the cut, so this ends.
 // Returns the cut's 3D length, or -1 if a chord is left (an edge inside one side with both
 // ends on the cut).
-double smooth_cut(const TriMesh& mesh, const VertexStars& stars, std::vector<int>& side) {
+// The 3D angle of each face at each of its corners.
+RowMatrixX3d corner_angles(const TriMesh& mesh) {
+  RowMatrixX3d corner(mesh.num_faces(), 3);
+  for (int f = 0; f < mesh.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p = mesh.V.row(mesh.F(f, k)), a = mesh.V.row(mesh.F(f, (k + 1) % 3)),
+                            b = mesh.V.row(mesh.F(f, (k + 2) % 3));
+      corner(f, k) = std::atan2((a - p).cross(b - p).norm(), (a - p).dot(b - p));
+    }
+  return corner;
+}
+
+// `corner` holds corner_angles(mesh).
+double smooth_cut(const TriMesh& mesh, const VertexStars& stars, const RowMatrixX3d& corner, std::vector<int>& side) {
   const int n = mesh.num_vertices(), m = mesh.num_faces();
   // The face across the edge from corner k to corner k+1 of f (-1 if none).
   const auto across = [&](int f, int k) {
@@ -158,14 +171,8 @@ double smooth_cut(const TriMesh& mesh, const VertexStars& stars, std::vector<int
   // to a straight angle: a narrow spike of one side (a plane cut zigzags along mesh edges)
   // would be stretched several times over. Spikes move to the other side.
   std::vector<std::array<double, 2>> angle(n, {0.0, 0.0});
-  RowMatrixX3d corner(m, 3);
   for (int f = 0; f < m; ++f)
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d p = mesh.V.row(mesh.F(f, k)), a = mesh.V.row(mesh.F(f, (k + 1) % 3)),
-                            b = mesh.V.row(mesh.F(f, (k + 2) % 3));
-      corner(f, k) = std::atan2((a - p).cross(b - p).norm(), (a - p).dot(b - p));
-      angle[mesh.F(f, k)][side[f]] += corner(f, k);
-    }
+    for (int k = 0; k < 3; ++k) angle[mesh.F(f, k)][side[f]] += corner(f, k);
   const auto move = [&](int f) {
     for (int k = 0; k < 3; ++k) {
       const int v = mesh.F(f, k);
@@ -246,6 +253,7 @@ bool split_into_two_disks(const TriMesh& mesh, std::array<Piece, 2>& halves, int
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> principal(covariance);
   const VertexStars stars(mesh.F, mesh.num_vertices());
+  const RowMatrixX3d corner = corner_angles(mesh);  // the same for every axis's cut
   std::vector<std::pair<double, std::vector<int>>> cuts;
   std::vector<int> axes;
   for (int axis_index = 0; axis_index < 3; ++axis_index) {
@@ -261,7 +269,7 @@ bool split_into_two_disks(const TriMesh& mesh, std::array<Piece, 2>& halves, int
     if (split == 0 || split == m) continue;
     std::vector<int> side(m, 1);
     for (int i = 0; i < split; ++i) side[order[i]] = 0;
-    const double length = smooth_cut(mesh, stars, side);
+    const double length = smooth_cut(mesh, stars, corner, side);
     if (length <= 0) continue;
     cuts.emplace_back(length, std::move(side));
     axes.push_back(axis_index);
@@ -407,7 +415,7 @@ bool two_halves_sphere_map(const TriMesh& mesh, RowMatrixX3d& domain, std::vecto
 }  // namespace
 
 double detail::smooth_cut(const TriMesh& mesh, std::vector<int>& side) {
-  return mrsnake::smooth_cut(mesh, VertexStars(mesh.F, mesh.num_vertices()), side);
+  return mrsnake::smooth_cut(mesh, VertexStars(mesh.F, mesh.num_vertices()), corner_angles(mesh), side);
 }
 
 Eigen::Vector3d mobius_to_center(const Eigen::Vector3d& a, const Eigen::Vector3d& x) {
