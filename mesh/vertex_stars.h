@@ -25,4 +25,18 @@ struct VertexStars {
   }
 };
 
+/// The last face (in face order) of F holding the directed edge tail -> head, or -1: a scan of
+/// tail's star. On a consistently oriented manifold, the face across an edge a -> b of one face
+/// is face_with_directed_edge(stars, F, b, a).
+/// \pre `stars` are F's vertex stars; tail is one of their vertices.
+inline int face_with_directed_edge(const VertexStars& stars, const RowMatrixX3i& F, int tail, int head) {
+  int face = -1;
+  for (int i = stars.offset[tail]; i < stars.offset[tail + 1]; ++i) {
+    const int f = stars.faces[i];
+    for (int k = 0; k < 3; ++k)
+      if (F(f, k) == tail && F(f, (k + 1) % 3) == head) face = f;
+  }
+  return face;
+}
+
 }  // namespace mrsnake

@@ -9,18 +9,6 @@
 namespace mrsnake {
 namespace {
 
-// The last face (in face order) holding the directed edge tail -> head, or -1: a scan of
-// tail's star.
-int face_with_directed_edge(const VertexStars& stars, const RowMatrixX3i& F, int tail, int head) {
-  int face = -1;
-  for (int i = stars.offset[tail]; i < stars.offset[tail + 1]; ++i) {
-    const int f = stars.faces[i];
-    for (int k = 0; k < 3; ++k)
-      if (F(f, k) == tail && F(f, (k + 1) % 3) == head) face = f;
-  }
-  return face;
-}
-
 // Nearest point of triangle (a, b, c) to p, as barycentric coordinates (Ericson's method).
 Eigen::Vector3d closest_barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                     const Eigen::Vector3d& c) {

@@ -155,13 +155,7 @@ double smooth_cut(const TriMesh& mesh, const VertexStars& stars, const RowMatrix
   const int n = mesh.num_vertices(), m = mesh.num_faces();
   // The face across the edge from corner k to corner k+1 of f (-1 if none).
   const auto across = [&](int f, int k) {
-    const int a = mesh.F(f, k), b = mesh.F(f, (k + 1) % 3);
-    for (int i = stars.offset[a]; i < stars.offset[a + 1]; ++i) {
-      const int g = stars.faces[i];
-      for (int j = 0; j < 3; ++j)
-        if (g != f && mesh.F(g, j) == b && mesh.F(g, (j + 1) % 3) == a) return g;
-    }
-    return -1;
+    return face_with_directed_edge(stars, mesh.F, mesh.F(f, (k + 1) % 3), mesh.F(f, k));
   };
   std::vector<std::array<int, 2>> count(n, {0, 0});  // faces of each side around each vertex
   for (int f = 0; f < m; ++f)
