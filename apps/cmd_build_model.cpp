@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <future>
 #include <memory>
 #include <optional>
 #include <iostream>
@@ -120,11 +119,6 @@ void add_build_model_command(CLI::App& app) {
            " surface; closed its tunnels with a radius of " + std::to_string(surface.closing_radius) + " voxels");
     lap("marching_cubes");
 
-    // The report page measures every level against the input: its tree is built on the
-    // other core while the parameterization solve runs (single-threaded with the punctured
-    // map; the two-halves map uses both cores, and the tree then shares them).
-    std::future<std::unique_ptr<SurfaceLocator>> input_locator = std::async(
-        std::launch::async, [&surface] { return std::make_unique<SurfaceLocator>(surface.mesh); });
     RemeshOptions ro;
     ro.levels = a->levels;
     ro.target_faces = a->faces;
@@ -189,7 +183,10 @@ void add_build_model_command(CLI::App& app) {
     mrsnake::reports::RemeshPageOptions page;
     page.title = "mrsnake build-model " + std::filesystem::path(a->output).filename().string();
     page.input = &surface.mesh;
-    const std::unique_ptr<SurfaceLocator> locator = input_locator.get();
+    // The report page measures every level against the input: remesh() built that tree on the
+    // other core while the map was solved (it needs it for the fit).
+    std::shared_ptr<const SurfaceLocator> locator = hierarchy.input_locator;
+    if (!locator) locator = std::make_shared<SurfaceLocator>(surface.mesh);
     page.input_locator = locator.get();
     page.unrelaxed = unrelaxed ? &*unrelaxed : nullptr;
     page.report = quality;

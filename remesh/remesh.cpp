@@ -19,6 +19,7 @@
 #include "remesh/shape_smoothing.h"
 #include "remesh/simplify.h"
 #include "remesh/sizing.h"
+#include "remesh/surface_fit.h"
 #include "remesh/triangle_repair.h"
 #include "mesh/topology.h"
 
@@ -73,6 +74,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     throw std::invalid_argument("base_density_exponent must be in [0, 4]");
   if (options.base_density_smoothing < -1) throw std::invalid_argument("base_density_smoothing must be >= -1");
   if (options.snap_tips < 0) throw std::invalid_argument("snap_tips must be >= 0");
+  if (options.fit_rounds < 0) throw std::invalid_argument("fit_rounds must be >= 0");
   if (options.surface_relax_iterations < 0) throw std::invalid_argument("surface_relax_iterations must be >= 0");
   if (!(options.surface_relax_quality_floor >= 0 && options.surface_relax_quality_floor <= 1))
     throw std::invalid_argument("surface_relax_quality_floor must be in [0, 1]");
@@ -99,24 +101,34 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
 
   // A much finer input is simplified before the (costly) parameterization.
   TriMesh work = original;
-  std::unique_ptr<SurfaceLocator> reproject, input_locator;
+  bool simplified = false;
   const double finest_faces = 2.0 * n0 * std::pow(4.0, levels);
   const double limit = std::max<double>(options.simplify_above_faces, 8 * finest_faces);
   if (options.simplify_above_faces > 0 && original.num_faces() > limit) {
     report(options.progress, "simplify", 0);
-    TriMesh simplified = simplify_to_faces(original, static_cast<int>(limit));
+    TriMesh simplified_mesh = simplify_to_faces(original, static_cast<int>(limit));
     result.parameterization["simplify_seconds"] = seconds_since(simplify_start);
-    const TopologyReport after = topology_report(simplified);
+    const TopologyReport after = topology_report(simplified_mesh);
     if (after.is_disk() == topology.is_disk() && after.is_closed_genus0() == topology.is_closed_genus0()) {
-      work = std::move(simplified);
-      reproject = std::make_unique<SurfaceLocator>(original);
+      work = std::move(simplified_mesh);
+      simplified = true;
     }
   }
 
   report(options.progress, "parameterize", 0);
   ParameterizationOptions param_options;
   param_options.sphere_map = options.sphere_map;
-  const Parameterization param = parameterize(work, param_options);
+  Parameterization param;
+  // The input's closest-point tree (for the reprojection, the fit and the report's distances)
+  // is built on the other core while the map is solved.
+  std::shared_ptr<SurfaceLocator> input_locator;
+  const bool needs_locator = simplified || options.fit_rounds > 0 || options.compute_stats;
+  run_both_in_parallel([&] { param = parameterize(work, param_options); },
+                       [&] {
+                         if (needs_locator) input_locator = std::make_shared<SurfaceLocator>(original);
+                       });
+  result.input_locator = input_locator;
+  const SurfaceLocator* reproject = simplified ? input_locator.get() : nullptr;
   result.domain = param.kind == DomainKind::sphere ? "sphere" : "disk";
   const nlohmann::json simplify_info = result.parameterization;
   result.parameterization = param.summary;
@@ -241,7 +253,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       // Not against a staircase: its voxel steps, not the triangles, make the guard's distances.
       repair_options.guard_surface_error = options.repair_guard_finest && j == levels && !project_first;
       repair_options.error_tolerance = options.repair_error_tolerance;
-      if (project_first) repair_options.project_onto = reproject.get();
+      if (project_first) repair_options.project_onto = reproject;
       if (snapped > 0) repair_options.fixed = &snapped_mask;  // the tips stay exactly on the input
       repair = repair_worst_triangles(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, repair_options);
     }
@@ -251,6 +263,15 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     if (flipped > 0)
       throw AlgorithmError("level " + std::to_string(j) + " has " + std::to_string(flipped) +
                            " flipped triangles in the domain; the surface cannot be remeshed well");
+    SurfaceFitStats fit;
+    if (options.fit_rounds > 0 && j == levels) {
+      // Against the original input, with a disk's rim fixed.
+      SurfaceFitOptions fit_options;
+      fit_options.rounds = options.fit_rounds;
+      const std::vector<bool> rim =
+          kind == DomainKind::disk ? boundary_vertices(F, static_cast<int>(U.rows())) : std::vector<bool>{};
+      fit = fit_to_surface(F, level.positions, *input_locator, fit_options, rim);
+    }
     level.domain_positions = U;
     level.flipped_triangles = flipped;
     level.seconds = seconds_since(start) + (j == 0 ? setup_seconds : 0.0);
@@ -266,6 +287,10 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     s["shape_moves"] = shape_moves;
     s["repair_moves"] = repair.moves;
     s["snapped_vertices"] = snapped;
+    if (options.fit_rounds > 0 && j == levels)
+      s["fit"] = {{"rms_before_mm", fit.rms_before}, {"rms_after_mm", fit.rms_after}, {"mean_offset_mm", fit.mean_offset},
+                  {"max_offset_mm", fit.max_offset}, {"clamped_vertices", fit.clamped_vertices},
+                  {"held_vertices", fit.held_vertices}};
     if (repair.moves > 0) {
       s["repair_q_min_before"] = repair.q_min_before;
       s["repair_q_min_after"] = repair.q_min_after;
@@ -281,9 +306,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       sampling.samples_per_face =
           std::clamp(static_cast<int>(5e5 / std::max(original.num_faces(), mesh.num_faces())), 1, 10);
       sampling.max_samples_per_mesh = kMaxStatsSamples;
-      // The input's tree is built once for every level (the reprojection's when there is one).
-      if (!reproject && !input_locator) input_locator = std::make_unique<SurfaceLocator>(original);
-      s["distance"] = surface_distance(mesh, original, reproject ? *reproject : *input_locator, sampling);
+      s["distance"] = surface_distance(mesh, original, *input_locator, sampling);
       s["distance"]["samples_per_face"] = sampling.samples_per_face;
       s["distance"]["max_samples_per_mesh"] = sampling.max_samples_per_mesh;
     }
@@ -307,6 +330,7 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["base_density_exponent"] = options.base_density_exponent;
   j["repair_after_reprojection"] = options.repair_after_reprojection;
   j["snap_tips"] = options.relax == RelaxMode::all_vertices ? options.snap_tips : 0;
+  j["fit_rounds"] = options.fit_rounds;
   j["base_density_smoothing"] = options.base_density_smoothing;
   j["lloyd_iterations"] = options.lloyd_iterations;
   j["shape_iterations"] = options.relax == RelaxMode::all_vertices ? options.shape_iterations : 0;

@@ -7,11 +7,13 @@
 ///
 /// Domain: a closed genus-0 input is mapped onto the unit sphere (the boundary of a convex
 /// body; no seam), a disk input onto the unit disk (boundary on the circle).
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "mesh/distance.h"
 #include "mesh/progress.h"
 #include "mesh/subdivision.h"
 #include "mesh/trimesh.h"
@@ -105,6 +107,13 @@ struct RemeshOptions {
   /// simplified to that size before parameterization (remesh/simplify.h); the result is then
   /// projected back onto the original input. 0 = never simplify.
   int simplify_above_faces = 100000;
+  /// Rounds of the least-squares fit of the finest level to the input along the vertex normals
+  /// (remesh/surface_fit.h), after the repair: the lifted vertices sit on the input, so every
+  /// triangle is a chord, one-sided on a curved patch; the fit centres the triangles on the
+  /// surface. Only the finest level, which is what is measured against the input (a model's
+  /// coarse levels are recomputed from it by the wavelet analysis). 0 = off: every vertex stays
+  /// exactly on the input, as in the paper. 1: RMS -30 to -50 % on the bench meshes.
+  int fit_rounds = 1;
   /// Compute quality and distance per level into RemeshLevel::stats (costs time).
   bool compute_stats = true;
   ProgressFn progress;
@@ -112,7 +121,7 @@ struct RemeshOptions {
 
 /// One level of the result.
 struct RemeshLevel {
-  RowMatrixX3d positions;         ///< 3D positions, n_j rows (on the input surface)
+  RowMatrixX3d positions;         ///< 3D positions, n_j rows (on the input surface; the finest off it by the fit)
   RowMatrixX3d domain_positions;  ///< positions in D, n_j rows (unit sphere, or z = 1 plane for a disk)
   int flipped_triangles = 0;      ///< triangles with non-positive orientation in D (always 0)
   double seconds = 0;             ///< time spent building this level
@@ -129,6 +138,10 @@ struct RemeshResult {
   std::string domain;
   /// Summary of the parameterization: method, distortion range, seconds.
   nlohmann::json parameterization;
+  /// Closest points on the input (vertices renumbered without unreferenced ones), built while
+  /// the map was solved, for the reprojection, the fit and the distances; a caller that
+  /// measures against the input reuses it. Null when none of those needed it.
+  std::shared_ptr<const SurfaceLocator> input_locator;
 
   /// The 3D mesh of level j.
   TriMesh mesh(int level) const { return {levels[level].positions, connectivity.faces[level]}; }

@@ -1,10 +1,11 @@
 #pragma once
 /// \file surface_geometry.h
-/// Per-vertex geometry on a fixed connectivity: 1-rings built once per level (CSR), face
-/// and vertex normals, umbrella vectors and local edge lengths. Plain loops, no allocation
+/// Per-vertex geometry on a fixed connectivity: 1-rings built once per level (CSR),
+/// umbrella vectors and local edge lengths. Plain loops, no allocation
 /// in the per-iteration calls.
 #include <vector>
 
+#include "mesh/normals.h"  // face_normals, vertex_normals
 #include "mesh/trimesh.h"
 
 namespace mrsnake {
@@ -20,13 +21,6 @@ struct VertexRings {
 /// Builds the rings of the n vertices of F (each neighbour listed once).
 /// \pre F references only vertices in [0, n).
 VertexRings build_vertex_rings(const RowMatrixX3i& F, int n);
-
-/// Unit face normals (zero for a degenerate face).
-void face_normals(const RowMatrixX3d& V, const RowMatrixX3i& F, RowMatrixX3d& N);
-
-/// Unit vertex normals: the normalized sum of the area-weighted normals of the faces around
-/// each vertex (outward for an outward-oriented mesh).
-void vertex_normals(const RowMatrixX3d& V, const RowMatrixX3i& F, RowMatrixX3d& N);
 
 /// Umbrella vectors U_v = mean of the ring − x_v.
 void umbrella(const VertexRings& rings, const RowMatrixX3d& V, RowMatrixX3d& U);
