@@ -37,6 +37,14 @@ void add_sphere_map_option(CLI::App& command, SphereMap& map) {
       ->option_text("auto|halves|punctured");
 }
 
+void add_fit_rounds_option(CLI::App& command, int& rounds) {
+  command
+      .add_option("--fit-rounds", rounds,
+                  "Rounds of the least-squares fit of the finest level to the input along the vertex normals (default " +
+                      std::to_string(rounds) + "; 0 = off: every vertex stays on the input)")
+      ->check(CLI::Range(0, 100));
+}
+
 void refuse_non_finite_numbers(CLI::App& app) {
   const CLI::Validator finite(
       [](std::string& text) -> std::string {

@@ -47,6 +47,10 @@ void add_segment_command(CLI::App& app);
 /// Adds --sphere-map auto|halves|punctured (remesh and build-model), bound to `map`.
 void add_sphere_map_option(CLI::App& command, SphereMap& map);
 
+/// Adds --fit-rounds N (remesh and build-model), bound to `rounds` (RemeshOptions::fit_rounds);
+/// its current value is the default the help shows.
+void add_fit_rounds_option(CLI::App& command, int& rounds);
+
 /// Makes every FLOAT option of app and its subcommands refuse nan and inf with a usage error
 /// (CLI11's Range lets nan through: every comparison with it is false). Call after the
 /// commands are added.

@@ -70,10 +70,7 @@ void add_remesh_command(CLI::App& app) {
                   "Finest level: up to this many vertices snap onto the input's vertices farthest from it (default " +
                       std::to_string(RemeshOptions{}.snap_tips) + "; 0 = off; not with --strict or --no-relax)")
       ->check(CLI::Range(0, 100000));
-  cmd->add_option("--fit-rounds", args->options.fit_rounds,
-                  "Rounds of the least-squares fit of every level to the input along the vertex normals (default " +
-                      std::to_string(RemeshOptions{}.fit_rounds) + "; 0 = off: every vertex stays on the input)")
-      ->check(CLI::Range(0, 100));
+  add_fit_rounds_option(*cmd, args->options.fit_rounds);
   add_sphere_map_option(*cmd, args->options.sphere_map);
   cmd->add_option("--iterations", args->options.lloyd_iterations, "Lloyd iterations per level (default 8)")->check(CLI::Range(0, 1000));
   cmd->add_option("--shape-iterations", args->options.shape_iterations,

@@ -116,6 +116,7 @@ void add_segment_command(CLI::App& app) {
     for (const LevelOutcome& l : result.levels) {
       mrsnake::reports::SnakeConvergence c;
       c.level = l.level;
+      c.deformed = l.deformed;
       for (const auto& it : l.snake.history) {
         c.energy.push_back(it.energy);
         c.external_energy.push_back(it.external_energy);

@@ -122,7 +122,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   // The input's closest-point tree (for the reprojection, the fit and the report's distances)
   // is built on the other core while the map is solved.
   std::shared_ptr<SurfaceLocator> input_locator;
-  const bool needs_locator = simplified || options.fit_rounds > 0 || options.compute_stats;
+  const bool needs_locator = simplified || options.fit_rounds > 0 || options.compute_stats || options.keep_input_locator;
   run_both_in_parallel([&] { param = parameterize(work, param_options); },
                        [&] {
                          if (needs_locator) input_locator = std::make_shared<SurfaceLocator>(original);

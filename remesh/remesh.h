@@ -114,6 +114,9 @@ struct RemeshOptions {
   /// coarse levels are recomputed from it by the wavelet analysis). 0 = off: every vertex stays
   /// exactly on the input, as in the paper. 1: RMS -30 to -50 % on the bench meshes.
   int fit_rounds = 1;
+  /// Build RemeshResult::input_locator even if nothing here needs it (a caller that measures
+  /// against the input then gets the tree built on the other core while the map is solved).
+  bool keep_input_locator = false;
   /// Compute quality and distance per level into RemeshLevel::stats (costs time).
   bool compute_stats = true;
   ProgressFn progress;
@@ -140,7 +143,8 @@ struct RemeshResult {
   nlohmann::json parameterization;
   /// Closest points on the input (vertices renumbered without unreferenced ones), built while
   /// the map was solved, for the reprojection, the fit and the distances; a caller that
-  /// measures against the input reuses it. Null when none of those needed it.
+  /// measures against the input reuses it. Null when none of those needed it and
+  /// RemeshOptions::keep_input_locator was off.
   std::shared_ptr<const SurfaceLocator> input_locator;
 
   /// The 3D mesh of level j.

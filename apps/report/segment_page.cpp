@@ -131,7 +131,13 @@ std::string segment_report_html(const SegmentPageInput& in) {
     page.paragraph("Energy (mean matched cost plus the internal term) and the mean |matched offset| along the normals "
                    "at each iteration of each level.");
     page.begin_figures();
-    for (const SnakeConvergence& c : in.convergence)
+    for (const SnakeConvergence& c : in.convergence) {
+      if (!c.deformed) {
+        page.note("Level " + std::to_string(c.level) +
+                  " was not deformed: its edges are finer than the image allows (min_edge_voxels), so it is the "
+                  "wavelet synthesis of the level before.");
+        continue;
+      }
       picture(page, "The convergence plot of level " + std::to_string(c.level), [&] {
         std::vector<Series> series;
         if (!c.energy.empty()) series.push_back({"energy", iterations(c.energy.size()), c.energy});
@@ -141,6 +147,7 @@ std::string segment_report_html(const SegmentPageInput& in) {
         page.svg(svg_line_plot(series, "Level " + std::to_string(c.level) + " energy", "iteration", "energy"),
                  "level " + std::to_string(c.level) + ": " + std::to_string(c.energy.size()) + " iterations");
       });
+    }
     picture(page, "The offset plot", [&] {
       std::vector<Series> series;
       for (const SnakeConvergence& c : in.convergence)

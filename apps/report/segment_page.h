@@ -24,6 +24,7 @@ struct SnakeConvergence {
   std::vector<double> external_energy;     ///< mean matched cost
   std::vector<double> internal_energy;
   std::vector<double> mean_abs_offset_mm;  ///< mean |matched offset|, mm
+  bool deformed = true;                    ///< false: finer than the image, only synthesized (no iterations)
 };
 
 struct SegmentPageInput {

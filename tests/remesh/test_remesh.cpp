@@ -521,6 +521,19 @@ TEST(RemeshCli, WritesNestedLevelsAndReport) {
   std::ifstream in_halves(dir / "halves" / "report.json");
   EXPECT_GT(nlohmann::json::parse(in_halves)["parameterization"].value("cut_vertices", 0), 0);
   EXPECT_EQ(test::run_mrsnake("-q remesh " + input + " -o " + (dir / "bad").string() + " --sphere-map north").exit_code, 2);
+  // The finest level is fitted by default (report key "fit"); --fit-rounds 0 turns it off.
+  EXPECT_EQ(report["fit_rounds"].get<int>(), 1);
+  EXPECT_TRUE(report["per_level"][2].contains("fit"));
+  EXPECT_FALSE(report["per_level"][1].contains("fit"));
+  const auto unfitted = test::run_mrsnake("-q remesh " + input + " -o " + (dir / "unfitted").string() +
+                                          " --levels 2 --base-vertices 12 --fit-rounds 0");
+  ASSERT_EQ(unfitted.exit_code, 0) << unfitted.output;
+  std::ifstream in_unfitted(dir / "unfitted" / "report.json");
+  const auto unfitted_report = nlohmann::json::parse(in_unfitted);
+  EXPECT_FALSE(unfitted_report["per_level"][2].contains("fit"));
+  EXPECT_LT(report["per_level"][2]["distance"]["rms_pct"].get<double>(),
+            unfitted_report["per_level"][2]["distance"]["rms_pct"].get<double>());
+  EXPECT_EQ(test::run_mrsnake("-q remesh " + input + " -o " + (dir / "bad").string() + " --fit-rounds -1").exit_code, 2);
   std::filesystem::remove_all(dir);
 }
 

@@ -69,11 +69,19 @@ TEST(BuildModelCli, BuildsAModelThatModelInfoAccepts) {
   ASSERT_EQ(info.exit_code, 0) << info.output;
   EXPECT_TRUE(nlohmann::json::parse(info.output)["synthesis"]["ok"].get<bool>());
 
-  // --sphere-map halves reaches the remesher and model.json records it.
+  // A model's vertices stay on the reference surface unless --fit-rounds asks for the fit.
+  EXPECT_EQ(m.remesh_quality["fit_rounds"].get<int>(), 0);
+  EXPECT_FALSE(m.remesh_quality["per_level"].back().contains("fit"));
+
+  // --sphere-map halves and --fit-rounds reach the remesher and model.json records them.
   const std::string halves = (dir / "halves.model").string();
-  const auto built_halves = run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + halves + " --faces 2048 --sphere-map halves");
+  const auto built_halves = run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + halves +
+                                        " --faces 2048 --sphere-map halves --fit-rounds 1");
   ASSERT_EQ(built_halves.exit_code, 0) << built_halves.output;
-  EXPECT_EQ(load_model(halves, {true}).remesh_quality["parameterization"]["sphere_map"], "two_halves");
+  const ShapeModel fitted = load_model(halves, {true});
+  EXPECT_EQ(fitted.remesh_quality["parameterization"]["sphere_map"], "two_halves");
+  EXPECT_EQ(fitted.remesh_quality["fit_rounds"].get<int>(), 1);
+  EXPECT_TRUE(fitted.remesh_quality["per_level"].back().contains("fit"));
 }
 
 TEST(BuildModelCli, McSpacingZeroUsesTheVoxelSurface) {
