@@ -184,6 +184,7 @@ void add_build_model_command(CLI::App& app) {
       RemeshOptions plain = ro;
       plain.relax = RelaxMode::none;
       plain.compute_stats = false;
+      plain.keep_input_locator = false;
       unrelaxed = remesh(surface.mesh, plain);
     }
     report(progress, "report.html", 0.0);

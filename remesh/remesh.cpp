@@ -122,7 +122,10 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   // The input's closest-point tree (for the reprojection, the fit and the report's distances)
   // is built on the other core while the map is solved.
   std::shared_ptr<SurfaceLocator> input_locator;
-  const bool needs_locator = simplified || options.fit_rounds > 0 || options.compute_stats || options.keep_input_locator;
+  // Like the snap and the repair, the fit is part of the full method only: --no-relax and
+  // --strict stay the paper's baseline and exact method, with every vertex on the input.
+  const int fit_rounds = options.relax == RelaxMode::all_vertices ? options.fit_rounds : 0;
+  const bool needs_locator = simplified || fit_rounds > 0 || options.compute_stats || options.keep_input_locator;
   run_both_in_parallel([&] { param = parameterize(work, param_options); },
                        [&] {
                          if (needs_locator) input_locator = std::make_shared<SurfaceLocator>(original);
@@ -264,13 +267,18 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       throw AlgorithmError("level " + std::to_string(j) + " has " + std::to_string(flipped) +
                            " flipped triangles in the domain; the surface cannot be remeshed well");
     SurfaceFitStats fit;
-    if (options.fit_rounds > 0 && j == levels) {
-      // Against the original input, with a disk's rim fixed.
+    if (fit_rounds > 0 && j == levels) {
+      // Against the original input. A disk's rim stays on the input's rim, and the snapped
+      // tips stay exactly on the input's tips (they were kept for lowering the largest distance).
       SurfaceFitOptions fit_options;
-      fit_options.rounds = options.fit_rounds;
-      const std::vector<bool> rim =
+      fit_options.rounds = fit_rounds;
+      std::vector<bool> fixed =
           kind == DomainKind::disk ? boundary_vertices(F, static_cast<int>(U.rows())) : std::vector<bool>{};
-      fit = fit_to_surface(F, level.positions, *input_locator, fit_options, rim);
+      if (snapped > 0) {
+        if (fixed.empty()) fixed.assign(snapped_mask.size(), false);
+        for (std::size_t v = 0; v < snapped_mask.size(); ++v) fixed[v] = fixed[v] || snapped_mask[v];
+      }
+      fit = fit_to_surface(F, level.positions, *input_locator, fit_options, fixed);
     }
     level.domain_positions = U;
     level.flipped_triangles = flipped;
@@ -287,7 +295,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     s["shape_moves"] = shape_moves;
     s["repair_moves"] = repair.moves;
     s["snapped_vertices"] = snapped;
-    if (options.fit_rounds > 0 && j == levels)
+    if (fit_rounds > 0 && j == levels)
       s["fit"] = {{"rms_before_mm", fit.rms_before}, {"rms_after_mm", fit.rms_after}, {"mean_offset_mm", fit.mean_offset},
                   {"max_offset_mm", fit.max_offset}, {"clamped_vertices", fit.clamped_vertices},
                   {"held_vertices", fit.held_vertices}};
@@ -330,7 +338,7 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["base_density_exponent"] = options.base_density_exponent;
   j["repair_after_reprojection"] = options.repair_after_reprojection;
   j["snap_tips"] = options.relax == RelaxMode::all_vertices ? options.snap_tips : 0;
-  j["fit_rounds"] = options.fit_rounds;
+  j["fit_rounds"] = options.relax == RelaxMode::all_vertices ? options.fit_rounds : 0;
   j["base_density_smoothing"] = options.base_density_smoothing;
   j["lloyd_iterations"] = options.lloyd_iterations;
   j["shape_iterations"] = options.relax == RelaxMode::all_vertices ? options.shape_iterations : 0;

@@ -111,8 +111,9 @@ struct RemeshOptions {
   /// (remesh/surface_fit.h), after the repair: the lifted vertices sit on the input, so every
   /// triangle is a chord, one-sided on a curved patch; the fit centres the triangles on the
   /// surface. Only the finest level, which is what is measured against the input (a model's
-  /// coarse levels are recomputed from it by the wavelet analysis). 0 = off: every vertex stays
-  /// exactly on the input, as in the paper. 1: RMS -30 to -50 % on the bench meshes.
+  /// coarse levels are recomputed from it by the wavelet analysis). With all_vertices only, like
+  /// the snap and the repair. 0 = off: every vertex stays exactly on the input, as in the paper.
+  /// 1: RMS -9 to -51 % on the bench meshes (docs/bench-remesh.md, session 6).
   int fit_rounds = 1;
   /// Build RemeshResult::input_locator even if nothing here needs it (a caller that measures
   /// against the input then gets the tree built on the other core while the map is solved).

@@ -16,9 +16,11 @@ namespace mrsnake {
 namespace {
 
 // Quadrature points of the whole level: the vertices (rows 0..n-1), then the face centroids.
-// Per face, corners 1/12 and centroid 3/4 of its area: exact for quadratics, which the chord
-// error of a triangle on a curved patch is, and a third of the closest-point queries of a rule
-// with edge midpoints (the vertices start on the surface, so they need none at first).
+// Per face, corners 1/12 and centroid 3/4 of its area: a rule exact for quadratic integrands.
+// The chord error of a triangle on a curved patch is quadratic, so the integrands of the normal
+// equations are cubic and quartic and the rule only approximates them; on a sphere it still
+// gives the continuous optimum's uniform offset, and it needs a third of the closest-point
+// queries of a rule with edge midpoints (the vertices start on the surface: none at first).
 struct Quadrature {
   Eigen::VectorXd weight;  // per point
   Eigen::VectorXd mass;    // per vertex: a third of the area of its faces (the regularization's)
@@ -116,7 +118,7 @@ SurfaceFitStats fit_to_surface(const RowMatrixX3i& F, RowMatrixX3d& X, const Sur
     // Normal equations of  sum_s w_s (a_s . t - (d_s + a_s . t_now))^2 + lambda sum_v mass_v t_v^2,
     // with a_s the coefficients: each round linearizes at the offsets t_now it starts from.
     std::vector<Eigen::Triplet<double>> triplets;
-    triplets.reserve(static_cast<std::size_t>(n + 9 * m));
+    triplets.reserve(static_cast<std::size_t>(2 * n + 9 * m));  // vertex points, centroids, regularization
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
     double weight_sum = 0, squared_before = 0;
     for (Eigen::Index s = 0; s < points; ++s) {
@@ -151,7 +153,10 @@ SurfaceFitStats fit_to_surface(const RowMatrixX3i& F, RowMatrixX3d& X, const Sur
     solver.setTolerance(1e-8);
     solver.setMaxIterations(500);
     solver.compute(normal_matrix);
-    offset = solver.solveWithGuess(rhs, offset);
+    const Eigen::VectorXd solved = solver.solveWithGuess(rhs, offset);
+    // A solve that failed (or produced a NaN) keeps the offsets of the round before.
+    if (solver.info() == Eigen::NumericalIssue || !solved.allFinite()) break;
+    offset = solved;
     stats.clamped_vertices = 0;
     for (Eigen::Index v = 0; v < n; ++v) {
       const double limit = options.max_offset * edge_length(v);

@@ -35,19 +35,24 @@ struct SurfaceFitOptions {
 
 /// What fit_to_surface() did.
 struct SurfaceFitStats {
-  double rms_before = 0;     ///< quadrature-weighted RMS normal distance of the level's samples, before
-  double rms_after = 0;      ///< the same after the last round's solve (linearized), in mm
+  /// Quadrature estimates of the RMS normal distance from the level to the surface (mm): before
+  /// the fit, and after the last round's solve as linearized, before the triangle guard.
+  /// The rule weighs the corners more than the exact integral of the squared distance would:
+  /// on a sphere these say 1/2 where the integral says about 1/4.
+  double rms_before = 0;
+  double rms_after = 0;
   double mean_offset = 0;    ///< mean |offset| over the vertices, in mm
   double max_offset = 0;     ///< largest |offset|, in mm
-  int clamped_vertices = 0;  ///< vertices whose offset hit options.max_offset
+  int clamped_vertices = 0;  ///< vertices whose offset hit options.max_offset in the last round
   int held_vertices = 0;     ///< vertices pulled back because a triangle around them turned or lost quality
 };
 
 /// Moves every vertex of (X, F) along its vertex normal to minimize the squared normal
-/// distance from the level to `surface`, integrated over the level's triangles (corners and
-/// centroids, exact for quadratics), plus a small penalty on the offsets. Each round takes the
-/// closest points of the quadrature points, then solves the normal equations by conjugate
-/// gradients; after the first round, every vertex's own distance counts too.
+/// distance from the level to `surface`, integrated over the level's triangles (a quadrature on
+/// the corners and centroids, exact for quadratic integrands), plus a small penalty on the
+/// offsets. Each round takes the closest points of the quadrature points, then solves the
+/// normal equations by conjugate gradients. The first round takes the vertices' own distance as
+/// 0 (they start on the surface); later rounds query them too.
 /// \pre surface_locator was built on the input surface and every vertex of X lies on it (as
 ///      lifted or projected: the first round takes their distance as 0); F is a manifold
 ///      triangle mesh on the rows of X; fixed is empty or has one entry per row of X.

@@ -362,8 +362,9 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     out.vertices = static_cast<int>(V.rows());
     out.synthesis_seconds = synthesis_seconds;
     const RowMatrixX3d V_level_start = V;
-    // With profiles, a level finer than the image's voxels is only synthesized: its profiles
-    // sample the same voxels as its parent's, and on the real images its snake lost Dice.
+    // With profiles, a level finer than the image (mean edge below min_edge_voxels) is only
+    // synthesized: its profiles sample the same voxels as its parent's, and on the real images
+    // its snake lost Dice.
     // (The step-edge force fits sub-voxel steps; on synthetic volumes those levels help.)
     const bool finer_than_image = use_profiles && edges[j] < options.min_edge_voxels * spacings[0];
     SnakeLevelReport skipped;

@@ -128,7 +128,7 @@ TEST(Remesh, FineInputIsSimplifiedThenProjectedBackOntoIt) {
   const RemeshResult r = remesh(input, o);
   EXPECT_LT(r.parameterization["parameterized_faces"].get<int>(), input.num_faces());
   EXPECT_GE(r.parameterization["parameterized_faces"].get<int>(), 2000);
-  expect_nested_and_valid(r, input, true);  // includes: every vertex lies on the original input
+  expect_nested_and_valid(r, input, true);  // includes: every vertex lies on the original input (the finest near it)
 }
 
 TEST(Remesh, StrictModeKeepsCoarseVerticesInTheDomain) {
