@@ -34,8 +34,8 @@ void add_build_model_command(CLI::App& app) {
     double reference_margin_mm = 20.0;
     SphereMap sphere_map = SphereMap::automatic;
     // Off by default, unlike remesh: a model's vertices stay on the reference surface. With the
-    // fit, the segmentation bench's 128³ Dice fell by 0.0002-0.0004 on 9 of 10 cases (the
-    // snake's profile matching already puts its vertices on the edges the model is drawn to).
+    // fit, the segmentation bench's 128³ Dice fell by 0.0002-0.0004 on 9 of 10 cases
+    // (docs/bench-segment.md, session 6).
     int fit_rounds = 0;
   };
   auto a = std::make_shared<Args>();
