@@ -8,9 +8,11 @@
 #include "apps/cli.h"
 #include "apps/report/segment_page.h"
 #include "mesh/atomic_file.h"
+#include "mesh/distance.h"
 #include "mesh/errors.h"
 #include "mesh/image_io.h"
 #include "mesh/mesh_io.h"
+#include "mesh/parallel.h"
 #include "snake/evaluate.h"
 #include "snake/model_bridge.h"
 #include "snake/rasterize.h"
@@ -18,6 +20,37 @@
 #include "wavelets/model_io.h"
 
 namespace mrsnake::cli {
+
+namespace {
+
+// report.html: slices with the contours, a render, convergence per level, timings.
+void write_segment_page(const std::filesystem::path& path, const std::string& image_path, const Volume& image,
+                        const Volume* truth, int truth_label, const SegmentResult& result, const nlohmann::json& rep) {
+  mrsnake::reports::SegmentPageInput page;
+  page.title = "mrsnake segment " + std::filesystem::path(image_path).filename().string();
+  page.image = &image;
+  page.surface = &result.surface;
+  if (truth) {
+    page.truth = truth;
+    page.truth_label = static_cast<float>(truth_label);
+  }
+  for (const LevelOutcome& l : result.levels) {
+    mrsnake::reports::SnakeConvergence c;
+    c.level = l.level;
+    c.deformed = l.deformed;
+    for (const auto& it : l.snake.history) {
+      c.energy.push_back(it.energy);
+      c.external_energy.push_back(it.external_energy);
+      c.internal_energy.push_back(it.internal_energy);
+      c.mean_abs_offset_mm.push_back(it.mean_abs_offset_mm);
+    }
+    page.convergence.push_back(std::move(c));
+  }
+  page.report = rep;
+  mrsnake::reports::write_segment_report(path.string(), page);
+}
+
+}  // namespace
 
 void add_segment_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("segment", "Segment a volume with a shape model: coarse-to-fine snake, labels, surfaces and a report");
@@ -70,14 +103,27 @@ void add_segment_command(CLI::App& app) {
     const SnakeModel model = snake_model_from(load_model(a->model));
     const double load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_load).count();
 
-    const SegmentResult result = segment(image, model, options, progress);
+    // The self-intersection count runs below, beside the rasterization.
+    options.count_self_intersections = false;
+    SegmentResult result = segment(image, model, options, progress);
     if (result.registration && !result.registration->accepted)
       warn("the reference image registration was not used (" + result.registration->rejection + "); initialized with " +
            to_string(result.init) + " instead");
     report(progress, "rasterize", 0.0);
-    const auto t_out = std::chrono::steady_clock::now();
-    const Volume labels = rasterize_mesh(result.surface, image, 1.0f);
-    const double rasterize_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_out).count();
+    Volume labels;
+    double rasterize_seconds = 0, count_seconds = 0;
+    run_both_in_parallel(
+        [&] {
+          const auto t = std::chrono::steady_clock::now();
+          labels = rasterize_mesh(result.surface, image, 1.0f);
+          rasterize_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+        },
+        [&] {
+          const auto t = std::chrono::steady_clock::now();
+          result.self_intersections = count_self_intersections(result.surface);
+          count_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+        });
+    result.stage_seconds.emplace_back("self_intersections", count_seconds);
 
     nlohmann::json rep = segment_report(result);
     rep["image"] = a->image;
@@ -98,35 +144,17 @@ void add_segment_command(CLI::App& app) {
     AtomicDirectory out(a->output);
     const std::filesystem::path dir = out.temp_path();
     std::filesystem::create_directories(dir / "levels");
-    write_mesh((dir / "surface.vtp").string(), result.surface);
-    for (const LevelOutcome& l : result.levels)
-      write_mesh((dir / "levels" / ("level_" + std::to_string(l.level) + ".vtp")).string(), l.surface);
-    write_volume((dir / "labels.nii.gz").string(), labels, VoxelType::uint8);
-    write_text_file_atomically((dir / "report.json").string(), rep.dump(2) + "\n");
-    // The page for people: slices with the contours, a render, convergence per level, timings.
-    report(progress, "report.html", 0.0);
-    mrsnake::reports::SegmentPageInput page;
-    page.title = "mrsnake segment " + std::filesystem::path(a->image).filename().string();
-    page.image = &image;
-    page.surface = &result.surface;
-    if (!a->truth.empty()) {
-      page.truth = &truth;
-      page.truth_label = static_cast<float>(a->truth_label);
-    }
-    for (const LevelOutcome& l : result.levels) {
-      mrsnake::reports::SnakeConvergence c;
-      c.level = l.level;
-      c.deformed = l.deformed;
-      for (const auto& it : l.snake.history) {
-        c.energy.push_back(it.energy);
-        c.external_energy.push_back(it.external_energy);
-        c.internal_energy.push_back(it.internal_energy);
-        c.mean_abs_offset_mm.push_back(it.mean_abs_offset_mm);
-      }
-      page.convergence.push_back(std::move(c));
-    }
-    page.report = rep;
-    mrsnake::reports::write_segment_report((dir / "report.html").string(), page);
+    const auto write_meshes_and_pages = [&] {
+      write_mesh((dir / "surface.vtp").string(), result.surface);
+      for (const LevelOutcome& l : result.levels)
+        write_mesh((dir / "levels" / ("level_" + std::to_string(l.level) + ".vtp")).string(), l.surface);
+      write_text_file_atomically((dir / "report.json").string(), rep.dump(2) + "\n");
+      write_segment_page(dir / "report.html", a->image, image, a->truth.empty() ? nullptr : &truth, a->truth_label,
+                         result, rep);
+    };
+    // The compressed labels are written on the other core, beside the meshes and the page.
+    run_both_in_parallel(write_meshes_and_pages,
+                         [&] { write_volume((dir / "labels.nii.gz").string(), labels, VoxelType::uint8); });
     out.commit();
     report(progress, "done", 1.0);
 
