@@ -8,9 +8,16 @@
 
 namespace mrsnake {
 
-/// A simplification of `mesh` to about `target_faces` faces (topology preserved).
+/// A simplification of `mesh` to about `target_faces` faces (topology preserved), on two cores:
+/// each simplifies one half, and the halves are stitched (one core's way if they do not fit).
 /// \pre mesh is a manifold disk or closed genus-0 surface; target_faces >= 8.
 /// \throw AlgorithmError if CGAL cannot build or simplify the surface.
 TriMesh simplify_to_faces(const TriMesh& mesh, int target_faces);
+
+namespace detail {
+/// The two-halves way alone, exposed for tests.
+/// \throw AlgorithmError if the surface cannot be built or the halves do not fit together.
+TriMesh simplify_in_two_halves(const TriMesh& mesh, int target_faces);
+}  // namespace detail
 
 }  // namespace mrsnake

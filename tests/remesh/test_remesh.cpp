@@ -20,6 +20,7 @@
 #include "remesh/lloyd.h"
 #include "remesh/parameterization.h"
 #include "remesh/remesh.h"
+#include "remesh/simplify.h"
 #include "remesh/sizing.h"
 #include "remesh/triangle_repair.h"
 #include "tests/remesh/remesh_shapes.h"
@@ -129,6 +130,43 @@ TEST(Remesh, FineInputIsSimplifiedThenProjectedBackOntoIt) {
   EXPECT_LT(r.parameterization["parameterized_faces"].get<int>(), input.num_faces());
   EXPECT_GE(r.parameterization["parameterized_faces"].get<int>(), 2000);
   expect_nested_and_valid(r, input, true);  // includes: every vertex lies on the original input (the finest near it)
+}
+
+// Edges of (V, F) shorter than `length`, each counted once.
+int edges_shorter_than(const TriMesh& mesh, double length) {
+  int count = 0;
+  for (int f = 0; f < mesh.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = mesh.F(f, k), b = mesh.F(f, (k + 1) % 3);
+      if (a < b && (mesh.V.row(a) - mesh.V.row(b)).norm() < length) ++count;
+    }
+  return count;
+}
+
+TEST(Simplification, HalvesStitchIntoOneClosedSurfaceOfTheWantedSize) {
+  // Two cores each simplify one half, the cut frozen; the stitched halves must be one closed
+  // genus-0 surface (a cut vertex kept twice would open a boundary), of the wanted size, near
+  // the input, and the cut (still at the input's resolution when stitched) collapsed like the rest.
+  const TriMesh input = ellipsoid(5);  // 20480 faces, edges about 0.05-0.11 long
+  const double input_mean_edge = mesh_quality(input).edge_length_mean;
+  const TriMesh out = detail::simplify_in_two_halves(input, 3000);
+  const TopologyReport t = topology_report(out);
+  EXPECT_TRUE(t.is_closed_genus0());
+  EXPECT_TRUE(t.is_manifold());
+  EXPECT_EQ(t.degenerate_faces, 0);
+  EXPECT_GE(out.num_faces(), 2990);
+  EXPECT_LE(out.num_faces(), 3000);
+  const SurfaceLocator near_input(input);
+  EXPECT_LT(near_input.distances(out.V).maxCoeff(), 0.05);
+  EXPECT_LT(edges_shorter_than(out, input_mean_edge), 15) << "of " << out.num_faces() * 3 / 2 << " edges";
+
+  const TriMesh cap = spherical_cap(5);  // a disk stays a disk
+  const TriMesh cap_out = detail::simplify_in_two_halves(cap, 1500);
+  EXPECT_TRUE(topology_report(cap_out).is_disk());
+  EXPECT_NEAR(cap_out.num_faces(), 1500, 30);
+  // The public entry gives the same surface.
+  const TriMesh again = simplify_to_faces(input, 3000);
+  EXPECT_TRUE(again.V == out.V && again.F == out.F);
 }
 
 TEST(Remesh, StrictModeKeepsCoarseVerticesInTheDomain) {
