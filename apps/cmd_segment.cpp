@@ -144,17 +144,19 @@ void add_segment_command(CLI::App& app) {
     AtomicDirectory out(a->output);
     const std::filesystem::path dir = out.temp_path();
     std::filesystem::create_directories(dir / "levels");
-    const auto write_meshes_and_pages = [&] {
+    const auto write_meshes = [&] {
       write_mesh((dir / "surface.vtp").string(), result.surface);
       for (const LevelOutcome& l : result.levels)
         write_mesh((dir / "levels" / ("level_" + std::to_string(l.level) + ".vtp")).string(), l.surface);
       write_text_file_atomically((dir / "report.json").string(), rep.dump(2) + "\n");
-      write_segment_page(dir / "report.html", a->image, image, a->truth.empty() ? nullptr : &truth, a->truth_label,
-                         result, rep);
     };
-    // The compressed labels are written on the other core, beside the meshes and the page.
-    run_both_in_parallel(write_meshes_and_pages,
+    // The compressed labels are written on the other core, beside the meshes.
+    run_both_in_parallel(write_meshes,
                          [&] { write_volume((dir / "labels.nii.gz").string(), labels, VoxelType::uint8); });
+    // After the join: the page's render forks a child, which must not start while another
+    // thread may hold a lock (the allocator's, the loader's) that the child would then wait on.
+    write_segment_page(dir / "report.html", a->image, image, a->truth.empty() ? nullptr : &truth, a->truth_label, result,
+                       rep);
     out.commit();
     report(progress, "done", 1.0);
 

@@ -10,6 +10,8 @@
 
 #include <algorithm>
 #include <array>
+#include <new>
+#include <numeric>
 #include <vector>
 
 #include "mesh/errors.h"
@@ -26,8 +28,10 @@ using VertexIndex = SurfaceMesh::Vertex_index;
 using EdgeIndex = SurfaceMesh::Edge_index;
 namespace SMS = CGAL::Surface_mesh_simplification;
 
-// Vertex v and face f of the result are vertex v and face f of `mesh` (a collapse only removes
-// elements, and the garbage is not collected).
+// Vertex v and face f of the result start as vertex v and face f of `mesh`. A collapse removes
+// one end of its edge (the other keeps its index and takes the placement's position) and the
+// two faces at the edge; every other vertex and face keeps its index (the garbage is not
+// collected).
 SurfaceMesh to_surface_mesh(const TriMesh& mesh) {
   SurfaceMesh sm;
   std::vector<VertexIndex> vertex(mesh.num_vertices());
@@ -43,7 +47,8 @@ SurfaceMesh to_surface_mesh(const TriMesh& mesh) {
 // than 90°: keeps triangles well shaped, which the parameterization needs. The normal check as
 // a filter runs only on the collapse about to be made, not on every placement the queue
 // computes (2.52 -> 1.95 s on the liver staircase, 442k -> 128k faces, the same collapses).
-// Edges marked in `frozen` are never collapsed, and a vertex on one of them never moves.
+// Edges marked in `frozen` are never collapsed, and the point where a vertex on one of them
+// stands never moves (its index may: CGAL keeps either end of a collapsed edge).
 void collapse_shortest_edges(SurfaceMesh& sm, std::size_t max_edges, const SurfaceMesh::Property_map<EdgeIndex, bool>& frozen) {
   SMS::Count_stop_predicate<SurfaceMesh> stop(max_edges);
   SMS::Bounded_normal_change_filter<> normal_change;
@@ -55,6 +60,12 @@ void collapse_shortest_edges(SurfaceMesh& sm, std::size_t max_edges, const Surfa
                          .edge_is_constrained_map(frozen));
 }
 
+// Collapses edges of a closed surface until it has target_faces faces (3/2 as many edges).
+void collapse_to_faces(SurfaceMesh& sm, int target_faces) {
+  auto nothing_frozen = sm.add_property_map<EdgeIndex, bool>("e:frozen", false).first;
+  collapse_shortest_edges(sm, static_cast<std::size_t>(target_faces) * 3 / 2, nothing_frozen);
+}
+
 // The faces are split in two halves across the median of their centroids along the longest
 // side of the bounding box. Each core simplifies one half of its own copy, with the other half
 // and the edges on the cut frozen (so the cut's vertices stay where they are), and the two
@@ -64,16 +75,19 @@ void collapse_shortest_edges(SurfaceMesh& sm, std::size_t max_edges, const Surfa
 // \throw AlgorithmError if the surface cannot be built, or the halves do not fit together.
 SurfaceMesh simplify_halves(const TriMesh& mesh, int target_faces) {
   const int m = mesh.num_faces();
+  if (m == 0) return SurfaceMesh();
   const Eigen::RowVector3d extent = mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff();
   int axis = 0;
   extent.maxCoeff(&axis);
   std::vector<double> height(m);
   for (int f = 0; f < m; ++f) height[f] = mesh.V(mesh.F(f, 0), axis) + mesh.V(mesh.F(f, 1), axis) + mesh.V(mesh.F(f, 2), axis);
-  std::vector<double> sorted = height;
-  std::nth_element(sorted.begin(), sorted.begin() + m / 2, sorted.end());
-  const double median = m > 0 ? sorted[m / 2] : 0.0;
-  std::vector<int> side(m);
-  for (int f = 0; f < m; ++f) side[f] = height[f] < median ? 0 : 1;
+  // Ties (a staircase's heights are few) broken by face index, so that the halves are equal.
+  std::vector<int> order(m);
+  std::iota(order.begin(), order.end(), 0);
+  std::nth_element(order.begin(), order.begin() + m / 2, order.end(),
+                   [&](int a, int b) { return height[a] < height[b] || (height[a] == height[b] && a < b); });
+  std::vector<int> side(m, 1);
+  for (int i = 0; i < m / 2; ++i) side[order[i]] = 0;
 
   // The input's vertices on the cut (on faces of both sides): frozen in both halves.
   std::vector<std::array<char, 2>> on_side(mesh.num_vertices(), {0, 0});
@@ -148,8 +162,7 @@ SurfaceMesh simplify_halves(const TriMesh& mesh, int target_faces) {
     }
   }
   halves = {};
-  auto nothing_frozen = stitched.add_property_map<EdgeIndex, bool>("e:frozen", false).first;
-  collapse_shortest_edges(stitched, static_cast<std::size_t>(target_faces) * 3 / 2, nothing_frozen);
+  collapse_to_faces(stitched, target_faces);
   return stitched;
 }
 
@@ -179,6 +192,13 @@ TriMesh to_trimesh(SurfaceMesh& sm) {
   return out;
 }
 
+// One core's way: the whole surface in one pass.
+SurfaceMesh simplify_whole(const TriMesh& mesh, int target_faces) {
+  SurfaceMesh sm = to_surface_mesh(mesh);
+  collapse_to_faces(sm, target_faces);
+  return sm;
+}
+
 }  // namespace
 
 TriMesh simplify_to_faces(const TriMesh& mesh, int target_faces) {
@@ -187,9 +207,10 @@ TriMesh simplify_to_faces(const TriMesh& mesh, int target_faces) {
     simplified = simplify_halves(mesh, target_faces);
   } catch (const AlgorithmError&) {
     // One core's way, if the halves did not fit together (a non-manifold input fails here too).
-    simplified = to_surface_mesh(mesh);
-    auto nothing_frozen = simplified.add_property_map<EdgeIndex, bool>("e:frozen", false).first;
-    collapse_shortest_edges(simplified, static_cast<std::size_t>(target_faces) * 3 / 2, nothing_frozen);
+    simplified = simplify_whole(mesh, target_faces);
+  } catch (const std::bad_alloc&) {
+    // The halves hold three copies of the surface at once; one core's way holds one.
+    simplified = simplify_whole(mesh, target_faces);
   }
   return to_trimesh(simplified);
 }

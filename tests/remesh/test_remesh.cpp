@@ -166,6 +166,8 @@ TEST(Simplification, HalvesStitchIntoOneClosedSurfaceOfTheWantedSize) {
   EXPECT_NEAR(cap_out.num_faces(), 1500, 30);
   // The public entry gives the same surface.
   const TriMesh again = simplify_to_faces(input, 3000);
+  ASSERT_EQ(again.num_vertices(), out.num_vertices());
+  ASSERT_EQ(again.num_faces(), out.num_faces());
   EXPECT_TRUE(again.V == out.V && again.F == out.F);
 }
 
