@@ -249,8 +249,8 @@ Volume read_volume(const std::string& path) {
   try {
     if (std::filesystem::is_directory(path, ec)) return read_dicom_series(path);
     // The completeness check decompresses the whole stream once more: it runs on the other
-    // core while ITK reads (a 256³ float .nii.gz: load 1.07 -> 0.65 s). A truncated stream is the
-    // clearer message, so its error wins over ITK's.
+    // core while ITK reads (segment's load of a 256³ float .nii.gz: 1.07 -> 0.65 s). A truncated
+    // stream is the clearer message, so its error wins over ITK's.
     Volume volume;
     run_both_in_parallel([&] { check_gzip_complete(path); }, [&] { volume = read_with_itk(path); });
     return volume;
