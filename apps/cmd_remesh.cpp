@@ -41,7 +41,7 @@ void add_remesh_command(CLI::App& app) {
   no_relax->excludes(strict);
   cmd->add_option("--density-exponent", args->options.density_exponent, "Lloyd density = stretch^e (default 2: even 3D spacing)")
       ->check(CLI::Range(0.0, 8.0));
-  cmd->add_option("--curvature-weight", args->options.curvature_weight, "Denser where the surface bends: 3D density 1 + w·κ/mean κ (default 1; 0 = even spacing)")
+  cmd->add_option("--curvature-weight", args->options.curvature_weight, "Denser where the surface bends: 3D density 1 + w·κ/mean κ (default 0.5; 0 = even spacing)")
       ->check(CLI::Range(0.0, 100.0));
   cmd->add_option("--curvature-exponent", args->options.curvature_exponent,
                   "Curvature sizing exponent p: 3D density 1 + w·min((κ/mean κ)^p, 3) (default " +
