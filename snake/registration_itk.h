@@ -26,8 +26,9 @@ std::string to_string(RegistrationMetric metric);
 struct RegistrationOptions {
   RegistrationMetric metric = RegistrationMetric::mattes;
   int histogram_bins = 32;                     ///< Mattes only
-  /// Coarse to fine: shrink factors of the FIXED image per level, with the Gaussian
-  /// smoothing (in fixed voxels) applied before shrinking.
+  /// Coarse to fine: per level, both images are averaged over blocks of this many voxels per
+  /// axis, then smoothed by a Gaussian of smoothing_voxels (in input voxels; 0 = none), and
+  /// the transform found carries over to the next level.
   std::vector<int> shrink_factors{4, 2, 1};
   std::vector<double> smoothing_voxels{2.0, 1.0, 0.0};
   /// Metric samples per iteration and level (at most the voxels of that level), drawn on a
