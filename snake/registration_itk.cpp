@@ -95,7 +95,8 @@ class TimeGuard : public itk::Command {
 // full-resolution images at every coarse level, which took half of the registration's time;
 // here the Gaussian runs on images f³ times smaller. (Subtracting the block mean's own variance,
 // (f² − 1)/12, from the Gaussian's smoothed less and ended 1.09 mm from a blob's surface
-// against 0.84 mm, in tests/snake/test_registration.cpp.)
+// against 0.84 mm, in tests/snake/test_registration.cpp.) ITK's recursive Gaussian hardly
+// smooths below about half a voxel: the defaults give exactly 0.5 (2/4 and 1/2).
 struct ReducedImage {
   FloatImage::Pointer image;
   double residual_sigma_voxels = 0;
@@ -104,21 +105,25 @@ struct ReducedImage {
 ReducedImage bin_shrunk(FloatImage* input, int f, double sigma_fine) {
   ReducedImage out;
   out.image = input;
-  out.residual_sigma_voxels = std::max(0.0, sigma_fine);
+  out.residual_sigma_voxels = std::max(0.0, sigma_fine) / std::max(1, f);
   if (f <= 1) return out;
-  out.residual_sigma_voxels /= f;
-  const auto size = input->GetLargestPossibleRegion().GetSize();
   using Shrink = itk::BinShrinkImageFilter<FloatImage, FloatImage>;
   auto shrink = Shrink::New();
-  Shrink::ShrinkFactorsType factors;
-  for (unsigned a = 0; a < 3; ++a)  // keep at least 4 voxels per axis
-    factors[a] = static_cast<unsigned>(std::clamp<itk::SizeValueType>(size[a] / 4, 1, static_cast<itk::SizeValueType>(f)));
-  shrink->SetShrinkFactors(factors);
+  shrink->SetShrinkFactors(static_cast<unsigned>(f));
   shrink->SetInput(input);
   shrink->Update();
   out.image = shrink->GetOutput();
   out.image->DisconnectPipeline();
   return out;
+}
+
+// The largest factor <= f that leaves at least 4 voxels along every axis of both images: one
+// factor for all axes and both images, so that both are smoothed alike.
+int level_factor(int f, const FloatImage* a, const FloatImage* b) {
+  itk::SizeValueType smallest = std::numeric_limits<itk::SizeValueType>::max();
+  for (const FloatImage* image : {a, b})
+    for (unsigned axis = 0; axis < 3; ++axis) smallest = std::min(smallest, image->GetLargestPossibleRegion().GetSize()[axis]);
+  return static_cast<int>(std::clamp<itk::SizeValueType>(smallest / 4, 1, static_cast<itk::SizeValueType>(std::max(1, f))));
 }
 
 // A regular grid of about `count` physical points of the fixed image (voxel centres).
@@ -351,7 +356,7 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
     // first leaves only a small smoothing of the small images (see bin_shrunk).
     Optimizer::Pointer optimizer;
     for (std::size_t l = 0; l < levels && !guard->timed_out; ++l) {
-      const int f = std::max(1, o.shrink_factors[l]);
+      const int f = level_factor(o.shrink_factors[l], fixed_image, moving_image);
       const ReducedImage fixed_level = bin_shrunk(fixed_image, f, o.smoothing_voxels[l]);
       const ReducedImage moving_level = bin_shrunk(moving_image, f, o.smoothing_voxels[l]);
 
@@ -381,7 +386,7 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
       Registration::ShrinkFactorsArrayType shrink(1);
       shrink[0] = 1;
       Registration::SmoothingSigmasArrayType sigmas(1);
-      sigmas[0] = fixed_level.residual_sigma_voxels;  // the moving image's is the same
+      sigmas[0] = fixed_level.residual_sigma_voxels;  // the moving image's is the same (same f)
       const double voxels = static_cast<double>(fixed_level.image->GetLargestPossibleRegion().GetNumberOfPixels());
       Registration::MetricSamplingPercentageArrayType percentages(1);
       percentages[0] = std::clamp(o.samples_per_level / voxels, 0.01, 1.0);
@@ -400,6 +405,7 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
       registration->Update();
       result.iterations.push_back(guard->iterations - at_start);
     }
+    result.iterations.resize(levels, 0);  // the levels a spent time budget skipped
     result.stop_condition = guard->timed_out         ? "time budget spent"
                             : guard->level_converged ? "metric change below min_relative_change"
                                                      : optimizer->GetStopConditionDescription();

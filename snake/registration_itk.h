@@ -88,7 +88,7 @@ struct RegistrationResult {
   double initial_metric = 0;  ///< at the start transform, on the full-resolution images
   double final_metric = 0;    ///< the same evaluation at the result (lower is better)
   int valid_points_initial = 0, valid_points_final = 0;  ///< of the evaluation samples
-  std::vector<int> iterations;                ///< per level
+  std::vector<int> iterations;                ///< per level (0 for a level the time budget skipped)
   std::string stop_condition;                 ///< the optimizer's, at the last level
   int converged_levels = 0;                   ///< levels stopped by min_relative_change
   std::array<std::size_t, 3> moving_crop_size{0, 0, 0};
@@ -97,14 +97,14 @@ struct RegistrationResult {
   double cpu_seconds = 0;                     ///< process CPU time over the same span (all threads)
   double setup_seconds = 0;                   ///< crop, copies, parameter scales
   double evaluation_seconds = 0;              ///< the two metric evaluations
-  double optimization_seconds = 0;            ///< ITK's multi-resolution optimization
+  double optimization_seconds = 0;            ///< the levels: block means and ITK's optimization
 };
 
 /// Registers `fixed` to `moving` with a Similarity3DTransform (versor, translation, scale)
 /// about the centre of the fixed image, starting from options.initial_translation (by
-/// default the identity: both images in the same physical space): a multi-resolution
-/// ImageRegistrationMethodv4 with the chosen metric and regular step gradient descent
-/// (parameter scales from physical shifts). The moving image is first cropped to where the
+/// default the identity: both images in the same physical space), coarse to fine: per level
+/// one single-level ImageRegistrationMethodv4 on block-averaged images, with the chosen metric
+/// and regular step gradient descent (parameter scales from physical shifts). The moving image is first cropped to where the
 /// fixed image can land. Nothing is judged here: the caller compares initial and final
 /// metrics and the scale.
 /// \pre both volumes have data of their size; the fixed image has at least 8 voxels per axis.
