@@ -39,8 +39,8 @@ void add_build_model_command(CLI::App& app) {
     int fit_rounds = 0;
     // 1, unlike remesh's 0.5: more vertices where the organ bends. With 0.5 the real-data Dice
     // fell on 3 of 4 structures (left hippocampus 0.9499 -> 0.9446) and the synthetic ones moved
-    // by -0.0022..+0.0007 (docs/bench-segment.md, session 8); 0.5 buys triangle quality, which
-    // the snake does not need as much as the tips.
+    // by -0.0022..+0.0007 (docs/bench-segment.md, session 8). 0.5 buys triangle quality, and
+    // the snake measured better with the denser sampling of the bends.
     double curvature_weight = 1.0;
   };
   auto a = std::make_shared<Args>();

@@ -47,7 +47,7 @@ struct RemeshOptions {
   /// (remesh/sizing.h) and the Lloyd density (stretch·w)^density_exponent. 0 = even 3D spacing.
   /// 0.5: on bench/remesh's 12 rows, 1.0 left the bear at 16k faces with Q mean 0.889 (its
   /// sizes spread more than a regular connectivity can follow with equilateral triangles) and
-  /// 0.5 gave Q mean >= 0.908 everywhere with RMS still below CGAL's (docs/bench-remesh.md).
+  /// 0.5 gave Q mean >= 0.91 on every row with RMS still below CGAL's (docs/bench-remesh.md).
   double curvature_weight = 0.5;
   /// Curvature sizing exponent p: w = 1 + curvature_weight·min((κ/mean κ)^p, 3). The chord
   /// error of a triangle of size h is ~κh², so spacing ∝ κ^(-1/3) (p = 2/3) minimizes the mean

@@ -104,9 +104,9 @@ struct RegistrationResult {
 /// about the centre of the fixed image, starting from options.initial_translation (by
 /// default the identity: both images in the same physical space), coarse to fine: per level
 /// one single-level ImageRegistrationMethodv4 on block-averaged images, with the chosen metric
-/// and regular step gradient descent (parameter scales from physical shifts). The moving image is first cropped to where the
-/// fixed image can land. Nothing is judged here: the caller compares initial and final
-/// metrics and the scale.
+/// and regular step gradient descent (parameter scales from physical shifts). The moving
+/// image is first cropped to where the fixed image can land. Nothing is judged here: the
+/// caller compares initial and final metrics and the scale.
 /// \pre both volumes have data of their size; the fixed image has at least 8 voxels per axis.
 /// \throw InputError if the fixed image is too small or does not overlap the moving image.
 /// \throw AlgorithmError if ITK fails (e.g. too few samples land in the moving image).
