@@ -212,6 +212,34 @@ TEST(Registration, StopsALevelWhenTheMetricStopsChanging) {
   EXPECT_LT(early.final_metric, early.initial_metric);
 }
 
+TEST(Registration, ThinSlabsShrinkLessAndASpentBudgetStillReportsEveryLevel) {
+  // A reference crop only 9 voxels thick: a block factor of 4 would leave 2 voxels, so the
+  // coarse level takes the largest factor that leaves 4 (here 2), for both images alike.
+  const PosedPair pair = posed_pair(SynthShape::ellipsoid, 48, 8.0);
+  const Volume crop = reference_crop(pair.reference.image, pair.reference.truth_mesh.V);
+  ASSERT_GE(crop.size[2], 9u);
+  const long mid = static_cast<long>(crop.size[2] / 2);
+  const Volume slab = crop_volume(crop, {0, 0, mid - 4},
+                                  {static_cast<long>(crop.size[0]) - 1, static_cast<long>(crop.size[1]) - 1, mid + 4});
+  ASSERT_EQ(slab.size[2], 9u);
+  Volume normalized = pair.target.image;
+  normalize_intensities(normalized);
+  RegistrationOptions o;
+  o.max_seconds = 1e9;
+  const RegistrationResult r = register_similarity(slab, normalized, o);
+  ASSERT_EQ(r.iterations.size(), o.shrink_factors.size());
+  for (int n : r.iterations) EXPECT_GT(n, 0);
+  EXPECT_LT(r.final_metric, r.initial_metric);
+  // No time at all: the first level stops at its first iteration, the others do not run,
+  // and each still has its entry.
+  o.max_seconds = 0;
+  const RegistrationResult spent = register_similarity(slab, normalized, o);
+  ASSERT_EQ(spent.iterations.size(), o.shrink_factors.size());
+  EXPECT_EQ(spent.iterations[0], 1);
+  for (std::size_t l = 1; l < spent.iterations.size(); ++l) EXPECT_EQ(spent.iterations[l], 0) << "level " << l;
+  EXPECT_EQ(spent.stop_condition, "time budget spent");
+}
+
 TEST(Registration, StartsFromAGivenTranslation) {
   // The target's frame moved 60 mm away: from the identity there is no overlap; from the
   // right start translation the pose is found again (the retry of segment's registration
