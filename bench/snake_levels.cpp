@@ -66,7 +66,9 @@ int main(int argc, char** argv) {
                                         {"min_edge_voxels", &o.min_edge_voxels},
                                         {"distance_penalty", &o.profile_distance_penalty},
                                         {"edge_distance_penalty", &o.edge_distance_penalty},
-                                        {"min_gain", &o.search_min_gain}};
+                                        {"min_gain", &o.search_min_gain},
+                                        {"ring", &o.cost_ring_weight},
+                                        {"ring_cost", &o.cost_ring_full_weight_cost}};
     RegistrationOptions& reg = o.registration.itk;
     if (key == "reg_schedule") {  // shrink factors as digits, e.g. 421 (the default), 42, 21
       reg.shrink_factors.clear();

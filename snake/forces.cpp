@@ -37,6 +37,37 @@ int best_candidate(const std::vector<double>& cost, int nc, double min_gain) {
     if (cost[c] < cost[best] || (cost[c] == cost[best] && std::abs(c - nc) < std::abs(best - nc))) best = c;
   return cost[best] < cost[nc] - min_gain ? best : nc;
 }
+// Per vertex, the best candidate of its cost curve (row v of `cost`, candidates −nc..nc at
+// spacing h), refined by a parabola; see NormalSearchOptions::ring_weight for the mixing with
+// the ring's curves first.
+SearchResult pick_offsets(const Eigen::MatrixXd& cost, int nc, double h, const NormalSearchOptions& options) {
+  const int n = static_cast<int>(cost.rows());
+  const int C = static_cast<int>(cost.cols());
+  const VertexRings* rings = options.rings;
+  const bool mix = rings != nullptr && options.ring_weight > 0 && rings->num_vertices() == n;
+  SearchResult r;
+  r.offsets.setZero(n);
+  r.costs.setZero(n);
+  std::vector<double> curve(static_cast<std::size_t>(C));
+  for (int v = 0; v < n; ++v) {
+    for (int c = 0; c < C; ++c) curve[c] = cost(v, c);
+    const int valence = mix ? rings->valence(v) : 0;
+    if (valence > 0) {
+      // A sharp match of its own (low cost) keeps the vertex on its own evidence.
+      const double own_best = *std::min_element(curve.begin(), curve.end());
+      const double w = options.ring_full_weight_cost > 0
+                           ? options.ring_weight * std::min(1.0, own_best / options.ring_full_weight_cost)
+                           : options.ring_weight;
+      for (double& c : curve) c *= 1.0 - w;
+      for (int k = rings->offsets[v]; k < rings->offsets[v + 1]; ++k)
+        for (int c = 0; c < C; ++c) curve[c] += (w / valence) * cost(rings->neighbors[k], c);
+    }
+    const int best = best_candidate(curve, nc, options.min_gain);
+    r.offsets[v] = curve[best] <= options.max_cost ? (best - nc) * h + refine(curve, best, h) : 0.0;
+    r.costs[v] = curve[best];
+  }
+  return r;
+}
 }  // namespace
 
 SearchResult search_step_edges(const VolumeSampler& image, const RowMatrixX3d& V, const RowMatrixX3d& N,
@@ -47,10 +78,8 @@ SearchResult search_step_edges(const VolumeSampler& image, const RowMatrixX3d& V
   const int ns = 2 * (nc + w);  // samples at offsets (s − nc − w + 0.5)·h, s = 0..ns−1
   const double contrast2 = std::max(1e-12, (stats.inside - stats.outside) * (stats.inside - stats.outside));
   const double norm = 1.0 / (2.0 * w * contrast2);
-  SearchResult r;
-  r.offsets.setZero(V.rows());
-  r.costs.setZero(V.rows());
-  std::vector<double> in_prefix(ns + 1), out_prefix(ns + 1), cost(2 * nc + 1);
+  Eigen::MatrixXd cost(V.rows(), 2 * nc + 1);
+  std::vector<double> in_prefix(ns + 1), out_prefix(ns + 1);
   for (int v = 0; v < V.rows(); ++v) {
     const Eigen::Vector3d x = V.row(v), n = N.row(v);
     in_prefix[0] = out_prefix[0] = 0;
@@ -66,15 +95,10 @@ SearchResult search_step_edges(const VolumeSampler& image, const RowMatrixX3d& V
       const double misfit = (in_prefix[mid] - in_prefix[mid - w]) + (out_prefix[mid + w] - out_prefix[mid]);
       const double t = (c - nc) * h;
       const double rel = options.range_mm > 0 ? t / options.range_mm : 0.0;
-      cost[c] = misfit * norm + options.distance_penalty * rel * rel;
+      cost(v, c) = misfit * norm + options.distance_penalty * rel * rel;
     }
-    // (The minimum is taken once every candidate's cost is in: comparing during the loop
-    // read cost[nc] of the previous vertex before this one's was written.)
-    const int best = best_candidate(cost, nc, options.min_gain);
-    r.offsets[v] = cost[best] <= options.max_cost ? (best - nc) * h + refine(cost, best, h) : 0.0;
-    r.costs[v] = cost[best];
   }
-  return r;
+  return pick_offsets(cost, nc, h, options);
 }
 
 SearchResult search_profiles(const VolumeSampler& image, const RowMatrixX3d& V, const RowMatrixX3d& N,
@@ -88,11 +112,9 @@ SearchResult search_profiles(const VolumeSampler& image, const RowMatrixX3d& V, 
   const double h = profile_spacing_mm / sub;
   const int nc = std::max(0, static_cast<int>(std::floor(options.range_mm / h)));
   const int ns = 2 * nc + sub * (K - 1) + 1;  // samples at offsets (s − nc − sub·half)·h
-  SearchResult r;
-  r.offsets.setZero(V.rows());
-  r.costs.setZero(V.rows());
-  std::vector<double> samples(ns), cost(2 * nc + 1);
-  std::vector<double> model(K);
+  // A flat learned profile carries no information: no boundary seen (cost 1, beyond any max_cost).
+  Eigen::MatrixXd cost = Eigen::MatrixXd::Ones(V.rows(), 2 * nc + 1);
+  std::vector<double> samples(ns), model(K);
   for (int v = 0; v < V.rows(); ++v) {
     // The learned profile, centred and scaled to unit norm.
     double mean = 0;
@@ -103,11 +125,7 @@ SearchResult search_profiles(const VolumeSampler& image, const RowMatrixX3d& V, 
       model[k] = profiles(v, k) - mean;
       norm2 += model[k] * model[k];
     }
-    if (!(norm2 > 1e-12)) {  // a flat learned profile carries no information
-      r.offsets[v] = 0;
-      r.costs[v] = 1;
-      continue;
-    }
+    if (!(norm2 > 1e-12)) continue;
     const double inv = 1.0 / std::sqrt(norm2);
     for (double& m : model) m *= inv;
     const Eigen::Vector3d x = V.row(v), n = N.row(v);
@@ -124,13 +142,10 @@ SearchResult search_profiles(const VolumeSampler& image, const RowMatrixX3d& V, 
       const double ncc = var > 1e-12 ? dot / std::sqrt(var) : 0.0;
       const double t = (c - nc) * h;
       const double rel = options.range_mm > 0 ? t / options.range_mm : 0.0;
-      cost[c] = (1.0 - ncc) + options.distance_penalty * rel * rel;
+      cost(v, c) = (1.0 - ncc) + options.distance_penalty * rel * rel;
     }
-    const int best = best_candidate(cost, nc, options.min_gain);
-    r.offsets[v] = cost[best] <= options.max_cost ? (best - nc) * h + refine(cost, best, h) : 0.0;
-    r.costs[v] = cost[best];
   }
-  return r;
+  return pick_offsets(cost, nc, h, options);
 }
 
 RegionStats estimate_region_stats(const VolumeSampler& image, const RowMatrixX3d& V, const RowMatrixX3d& N,

@@ -12,6 +12,7 @@
 
 #include "mesh/trimesh.h"
 #include "snake/sampler.h"
+#include "snake/surface_geometry.h"
 
 namespace mrsnake {
 
@@ -33,6 +34,16 @@ struct NormalSearchOptions {
   /// near its boundary does not chase noise-level differences from one iteration to the next.
   /// Off by default: 0.01–0.04 lowered the Dice of the SNR 2 heart (0.9806 → 0.9782–0.9796).
   double min_gain = 0.0;
+  /// Evidence shared along the surface. With rings (the 1-rings of the surface, one per row
+  /// of V), vertex v's cost curve becomes (1 − w_v)·own + w_v·(mean of its ring's curves)
+  /// before its best candidate is taken, w_v = ring_weight·min(1, c_v/ring_full_weight_cost)
+  /// with c_v its own best cost (ring_full_weight_cost 0: w_v = ring_weight). Neighbours see
+  /// the same boundary a little to the side, so in noise their curves average the noise out
+  /// along the surface without blurring the boundary across it, as smoothing the image would;
+  /// a vertex with a sharp match of its own keeps it, so a real detail is not averaged away.
+  const VertexRings* rings = nullptr;  ///< not owned; nullptr = each vertex on its own
+  double ring_weight = 0.0;
+  double ring_full_weight_cost = 0.0;
 };
 
 /// Intensities inside the object and just outside it (normalized units).

@@ -183,12 +183,16 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     edges[j] = mean_edge_length(model.levels[j], model.faces(j));
     pyr[j] = pyramid_level_for_edge(edges[j], spacings, options.edge_per_voxel);
   }
-  const auto search_for = [&](int j, double range_mm, RegionStats stats) -> std::pair<ExternalSearch, double> {
+  const auto search_for = [&](int j, double range_mm, RegionStats stats,
+                              const VertexRings* rings) -> std::pair<ExternalSearch, double> {
     const int p = pyr[j];
     const VolumeSampler* sampler = &samplers[p];
     NormalSearchOptions so;
     so.range_mm = range_mm;
     so.min_gain = options.search_min_gain;
+    so.rings = rings;
+    so.ring_weight = options.cost_ring_weight;
+    so.ring_full_weight_cost = options.cost_ring_full_weight_cost;
     if (use_profiles) {
       const LevelAppearance* la = &model.appearance->levels[j];
       so.step_mm = options.profile_step_fraction * la->spacing_mm;
@@ -315,7 +319,9 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     // Fit the whole mesh of a level with enough vertices to carry the shape; synthesis
     // follows a similarity, so the pose found there applies to S_0 as well.
     const int jf = std::min(L, options.fit_level);
-    const auto [search, step] = search_for(jf, range_for(jf, options.coarse_range_edge_fraction, options.fit_min_range_voxels), stats);
+    // (One similarity moves the whole mesh here: every vertex keeps its own evidence.)
+    const double fit_range = range_for(jf, options.coarse_range_edge_fraction, options.fit_min_range_voxels);
+    const auto [search, step] = search_for(jf, fit_range, stats, nullptr);
     (void)step;
     double best_cost = std::numeric_limits<double>::infinity();
     for (const auto& [start, start_name] : starts) {
@@ -352,8 +358,8 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
       synthesis_seconds = seconds_since(t_syn);
     }
     const double range = range_for(j, options.range_edge_fraction, options.min_range_voxels);
-    const auto [search, step] = search_for(j, range, stats);
     const DeformableSurface snake(model.faces(j), model.levels[j], options.snake);
+    const auto [search, step] = search_for(j, range, stats, &snake.rings());
     LevelOutcome out;
     out.level = j;
     out.pyramid_level = pyr[j];

@@ -96,6 +96,13 @@ struct SegmentOptions {
   double profile_distance_penalty = 0.02;
   double edge_distance_penalty = 0.05;
   double search_min_gain = 0.0;
+  /// Search evidence shared with the 1-ring (NormalSearchOptions::ring_weight): a vertex
+  /// whose own best cost is c mixes in its ring's cost curves with weight
+  /// ring_weight·min(1, c/ring_full_weight_cost). On the 10 quick synthetic cases it raised the
+  /// SNR 2 heart's Dice from 0.9822 to 0.9844 and the mean from 0.99133 to 0.99161; a weight
+  /// that ignores the vertex's own cost (0.85 everywhere) lost up to 0.005 on real MRI.
+  double cost_ring_weight = 0.85;
+  double cost_ring_full_weight_cost = 0.2;
   /// Voxels (on a regular stride) from which the robust intensity window is estimated: a
   /// quarter of the default 2^20 takes a few ms instead of ~15 ms at 128³ and 256³ and moves
   /// the 1st and 99th percentiles by well under 1% of the window (tests/snake).

@@ -66,6 +66,20 @@ void fill_object(Volume& v, Phi phi, float in, float out, int n = 3) {
       }
 }
 
+// The faces of an n × n grid of vertices (vertex y·n + x), each square split along the same
+// diagonal: valence 6 inside.
+RowMatrixX3i grid_faces(int n) {
+  RowMatrixX3i F(2 * (n - 1) * (n - 1), 3);
+  int f = 0;
+  for (int y = 0; y + 1 < n; ++y)
+    for (int x = 0; x + 1 < n; ++x) {
+      const int a = y * n + x;
+      F.row(f++) << a, a + 1, a + n;
+      F.row(f++) << a + 1, a + n + 1, a + n;
+    }
+  return F;
+}
+
 }  // namespace
 
 TEST(Sampler, ExactOnALinearImageWithObliqueDirection) {
@@ -209,16 +223,7 @@ TEST(Internal, UmbrellaOfARegularPlanarPatchIsZero) {
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x)
       V.row(y * n + x) = (R * Eigen::Vector3d(x + 0.5 * y, y * std::sqrt(3.0) / 2, 0) + Eigen::Vector3d(1, 2, 3)).transpose();
-  std::vector<Eigen::Vector3i> faces;
-  for (int y = 0; y + 1 < n; ++y)
-    for (int x = 0; x + 1 < n; ++x) {
-      const int a = y * n + x;
-      faces.emplace_back(a, a + 1, a + n);
-      faces.emplace_back(a + 1, a + n + 1, a + n);
-    }
-  RowMatrixX3i F(faces.size(), 3);
-  for (std::size_t f = 0; f < faces.size(); ++f) F.row(f) = faces[f].transpose();
-  const VertexRings rings = build_vertex_rings(F, n * n);
+  const VertexRings rings = build_vertex_rings(grid_faces(n), n * n);
   RowMatrixX3d U;
   umbrella(rings, V, U);
   for (int y = 1; y + 1 < n; ++y)
@@ -544,6 +549,80 @@ TEST(Forces, MinGainKeepsAVertexInPlaceUnlessAMoveIsClearlyBetterOnEitherSide) {
       EXPECT_NEAR(r.offsets[0], -r.offsets[1], 1e-9) << f;
     }
   }
+}
+
+TEST(Forces, RingSharingAveragesNoiseButKeepsASharpMatchOfItsOwn) {
+  // Vertices on a 15 × 15 grid (1 mm apart) in the plane x = 9, normals +x.
+  const int n = 15;
+  const VertexRings rings = build_vertex_rings(grid_faces(n), n * n);
+  RowMatrixX3d V(n * n, 3), N(n * n, 3);
+  for (int y = 0; y < n; ++y)
+    for (int z = 0; z < n; ++z) {
+      V.row(y * n + z) = Eigen::RowVector3d(9.0, 1.0 + y, 1.0 + z);
+      N.row(y * n + z) = Eigen::RowVector3d(1, 0, 0);
+    }
+  NormalSearchOptions alone;
+  alone.range_mm = 4;
+  alone.step_mm = 0.5;
+  alone.window_mm = 2;
+  alone.max_cost = 10;  // keep every match, to compare the errors
+  NormalSearchOptions shared = alone;
+  shared.rings = &rings;
+  shared.ring_weight = 0.85;
+  const auto interior = [n](int v) { return v / n > 0 && v / n < n - 1 && v % n > 0 && v % n < n - 1; };
+
+  // 1. A plane boundary at x = 10.3 in strong noise (contrast 1, sigma 0.7): sharing the
+  //    ring's evidence brings the offsets closer to the true 1.3 mm.
+  Volume noisy = make_grid({24, 18, 18}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
+  fill_object(noisy, [](const Eigen::Vector3d& p) { return p.x() - 10.3; }, 1.0f, 0.0f, 5);
+  std::mt19937 rng(7);
+  std::normal_distribution<float> noise(0.0f, 0.7f);
+  for (float& x : noisy.data) x += noise(rng);
+  const VolumeSampler s(noisy);
+  const auto rms_error = [&](const SearchResult& r) {
+    double sum = 0;
+    int count = 0;
+    for (int v = 0; v < n * n; ++v)
+      if (interior(v)) {
+        sum += (r.offsets[v] - 1.3) * (r.offsets[v] - 1.3);
+        ++count;
+      }
+    return std::sqrt(sum / count);
+  };
+  const double error_alone = rms_error(search_step_edges(s, V, N, RegionStats{1.0, 0.0}, alone));
+  const double error_shared = rms_error(search_step_edges(s, V, N, RegionStats{1.0, 0.0}, shared));
+  EXPECT_GT(error_alone, 0.3);
+  EXPECT_LT(error_shared, 0.6 * error_alone) << error_alone;
+  // The cost-scaled weight shares too where the matches are poor, as they are in this noise.
+  NormalSearchOptions scaled = shared;
+  scaled.ring_full_weight_cost = 0.2;
+  EXPECT_LT(rms_error(search_step_edges(s, V, N, RegionStats{1.0, 0.0}, scaled)), 0.8 * error_alone);
+
+  // 2. A clean boundary with a 2 mm step at y = 7.5 (x = 10.3 below, 12.3 above): every
+  //    vertex has a sharp match of its own. A fixed weight drags the rows next to the step
+  //    towards the other side; the cost-scaled weight keeps each vertex on its own boundary.
+  Volume clean = make_grid({24, 18, 18}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
+  fill_object(clean, [](const Eigen::Vector3d& p) { return p.x() - (p.y() < 7.5 ? 10.3 : 12.3); }, 1.0f, 0.0f, 5);
+  const VolumeSampler c(clean);
+  const SearchResult own = search_step_edges(c, V, N, RegionStats{1.0, 0.0}, alone);
+  const SearchResult fixed = search_step_edges(c, V, N, RegionStats{1.0, 0.0}, shared);
+  const SearchResult kept = search_step_edges(c, V, N, RegionStats{1.0, 0.0}, scaled);
+  double worst_fixed = 0, worst_kept = 0;
+  for (int v = 0; v < n * n; ++v) {
+    if (!interior(v)) continue;
+    const double truth = V(v, 1) < 7.5 ? 1.3 : 3.3;
+    EXPECT_NEAR(own.offsets[v], truth, 0.15) << v;
+    worst_fixed = std::max(worst_fixed, std::abs(fixed.offsets[v] - truth));
+    worst_kept = std::max(worst_kept, std::abs(kept.offsets[v] - truth));
+  }
+  EXPECT_GT(worst_fixed, 0.25);  // measured 0.32
+  EXPECT_LT(worst_kept, 0.12);   // measured 0.08
+
+  // 3. Without rings (or with a weight of 0) the result is each vertex's own, exactly.
+  NormalSearchOptions zero = shared;
+  zero.ring_weight = 0;
+  const SearchResult none = search_step_edges(c, V, N, RegionStats{1.0, 0.0}, zero);
+  for (int v = 0; v < n * n; ++v) EXPECT_EQ(none.offsets[v], own.offsets[v]);
 }
 
 TEST(Appearance, SerializationRoundTripsAndRejectsDamage) {
