@@ -111,7 +111,7 @@ void mesh_index_box(const Volume& image, const RowMatrixX3d& V, double margin, s
 }
 
 ThresholdClasses threshold_classes(const Volume& image, const Volume& smooth, const std::array<long, 3>& lo,
-                                   const std::array<long, 3>& hi) {
+                                   const std::array<long, 3>& hi, std::size_t max_samples) {
   ThresholdClasses c;
   // The box in the smooth image's indices.
   std::array<long, 3> slo{}, shi{};
@@ -133,9 +133,13 @@ ThresholdClasses threshold_classes(const Volume& image, const Volume& smooth, co
   c.threshold = otsu_threshold(smooth, slo, shi);
   const VolumeSampler coarse(smooth);
   std::vector<float> upper, lower;
-  for (long k = lo[2]; k <= hi[2]; ++k)
-    for (long j = lo[1]; j <= hi[1]; ++j)
-      for (long i = lo[0]; i <= hi[0]; ++i) {
+  double box_voxels = 1;
+  for (int a = 0; a < 3; ++a) box_voxels *= static_cast<double>(std::max(0L, hi[a] - lo[a] + 1));
+  const long stride =
+      std::max(1L, static_cast<long>(std::ceil(std::cbrt(box_voxels / static_cast<double>(std::max<std::size_t>(1, max_samples))))));
+  for (long k = lo[2]; k <= hi[2]; k += stride)
+    for (long j = lo[1]; j <= hi[1]; j += stride)
+      for (long i = lo[0]; i <= hi[0]; i += stride) {
         const auto p = image.index_to_physical(static_cast<double>(i), static_cast<double>(j), static_cast<double>(k));
         const float v = image.at(i, j, k);
         (coarse.value(Eigen::Vector3d(p[0], p[1], p[2])) > c.threshold ? upper : lower).push_back(v);
