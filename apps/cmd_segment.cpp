@@ -71,7 +71,7 @@ void add_segment_command(CLI::App& app) {
   cmd->add_option("--register-metric", a->register_metric,
                   "Metric of --init register: mattes (mutual information) or mean_squares (normalized intensities)")
       ->capture_default_str();
-  cmd->add_option("--force", a->force, "External force: auto (profiles if the model has an appearance), profile, edge")
+  cmd->add_option("--force", a->force, "External force: auto (profiles if the model has an appearance, unless they learned a clean step), profile, edge")
       ->capture_default_str();
   cmd->add_option("--truth", a->truth, "Truth labels on the image's grid: adds the scores of 'mrsnake evaluate' to the report");
   cmd->add_option("--truth-label", a->truth_label, "Label of the object in --truth")->capture_default_str();

@@ -25,7 +25,7 @@ using namespace mrsnake;
 
 int main(int argc, char** argv) {
   if (argc < 4) {
-    std::fprintf(stderr, "usage: bench_snake_levels IMAGE MODEL_DIR TRUTH [--truth-label L] [--init MODE] [key=value ...]\n");
+    std::fprintf(stderr, "usage: bench_snake_levels IMAGE MODEL_DIR TRUTH [--truth-label L] [--init MODE] [--force MODE] [key=value ...]\n");
     return 2;
   }
   const Volume image = read_volume(argv[1]);
@@ -42,6 +42,10 @@ int main(int argc, char** argv) {
     }
     if (a == "--init" && i + 1 < argc) {
       o.init = parse_init_mode(argv[++i]);
+      continue;
+    }
+    if (a == "--force" && i + 1 < argc) {
+      o.force = parse_force_mode(argv[++i]);
       continue;
     }
     const auto eq = a.find('=');

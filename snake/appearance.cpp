@@ -166,6 +166,40 @@ Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes) {
   return a;
 }
 
+double profile_step_residual(const Appearance& a, const std::vector<RowMatrixX3i>& faces) {
+  const double inside = a.region.inside, outside = a.region.outside;
+  const double contrast = std::abs(inside - outside);
+  if (!(contrast > 1e-9) || faces.size() != a.levels.size()) return std::numeric_limits<double>::infinity();
+  double worst = -1;
+  std::vector<double> residuals, mean;
+  for (std::size_t j = 0; j < a.levels.size(); ++j) {
+    const auto& P = a.levels[j].profiles;
+    const int n = static_cast<int>(P.rows()), K = static_cast<int>(P.cols()), half = K / 2;
+    if (n == 0 || K == 0 || (faces[j].size() > 0 && faces[j].maxCoeff() >= n)) return std::numeric_limits<double>::infinity();
+    const VertexRings rings = build_vertex_rings(faces[j], n);
+    residuals.clear();
+    mean.assign(static_cast<std::size_t>(K), 0.0);
+    for (int v = 0; v < n; ++v) {
+      // The closed 1-ring's mean profile: the reference image's noise averages out, a
+      // neighbouring tissue (coherent along the surface) does not.
+      for (int k = 0; k < K; ++k) mean[k] = P(v, k);
+      for (int i = rings.offsets[v]; i < rings.offsets[v + 1]; ++i)
+        for (int k = 0; k < K; ++k) mean[k] += P(rings.neighbors[i], k);
+      double sum2 = 0;
+      for (int k = 0; k < K; ++k) {
+        const double ideal = k < half ? inside : (k > half ? outside : 0.5 * (inside + outside));
+        const double d = mean[k] / (rings.valence(v) + 1) - ideal;
+        sum2 += d * d;
+      }
+      residuals.push_back(std::sqrt(sum2 / K) / contrast);
+    }
+    const auto p90 = residuals.begin() + static_cast<long>(residuals.size() * 9 / 10);
+    std::nth_element(residuals.begin(), p90, residuals.end());
+    worst = std::max(worst, *p90);
+  }
+  return worst < 0 ? std::numeric_limits<double>::infinity() : worst;
+}
+
 void to_json(nlohmann::json& j, const Appearance& a) {
   j = nlohmann::json{{"levels", a.levels.size()},
                      {"samples_per_profile", 2 * a.half_length + 1},

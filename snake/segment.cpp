@@ -122,8 +122,16 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   const int L = model.finest_level();
   if (L < 0 || static_cast<int>(model.levels.size()) != L + 1 || !model.synthesize)
     throw InputError("the model has no usable levels; rebuild it with mrsnake build-model");
+  // Automatic: the profiles, unless what they learned is a clean step between two
+  // intensities; there the step-edge force, which fits the step at sub-voxel precision on
+  // every level, is both more accurate and faster (synthetic blobs at 128³: Dice
+  // 0.9941–0.9956 with profiles, 0.9956–0.9971 with the step).
+  const double step_residual =
+      model.appearance ? profile_step_residual(*model.appearance, model.connectivity.faces)
+                       : std::numeric_limits<double>::infinity();
   const bool use_profiles = options.force == ForceMode::profile ||
-                            (options.force == ForceMode::automatic && model.appearance.has_value());
+                            (options.force == ForceMode::automatic && model.appearance.has_value() &&
+                             !(step_residual <= options.clean_step_max_residual));
   if (use_profiles) {
     if (!model.appearance)
       throw InputError("--force profile needs a model built with an appearance (build-model --image)");
@@ -135,6 +143,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   }
   SegmentResult result;
   result.force = use_profiles ? "profile" : "step_edge";
+  result.profile_step_residual = step_residual;
   auto stage_timer = Clock::now();
   const auto end_stage = [&](const std::string& name) {
     result.stage_seconds.emplace_back(name, seconds_since(stage_timer));
@@ -401,6 +410,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
 nlohmann::json segment_report(const SegmentResult& r) {
   nlohmann::json j;
   j["force"] = r.force;
+  if (std::isfinite(r.profile_step_residual)) j["profile_step_residual"] = r.profile_step_residual;
   j["compute_seconds"] = r.compute_seconds;
   nlohmann::json stages = nlohmann::json::object();
   for (const auto& [name, s] : r.stage_seconds) stages[name] = s;

@@ -5,6 +5,7 @@
 /// for each level j deform S_j on the matching pyramid level and synthesize S_{j+1} from the
 /// deformed S_j with the model's details. The connectivity never changes.
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -68,7 +69,10 @@ struct SegmentOptions {
   /// The registration routes; when the registration is rejected they fall back to the
   /// moments routes (register → moments, register+fit → moments+fit).
   ReferenceRegistrationOptions registration;
-  ForceMode force = ForceMode::automatic;  ///< automatic: profile when the model has an appearance
+  /// automatic: profile when the model has an appearance whose profiles are not a clean step
+  /// (profile_step_residual above clean_step_max_residual), else step_edge.
+  ForceMode force = ForceMode::automatic;
+  double clean_step_max_residual = 0.2;
   TargetFitOptions fit;
   int fit_level = 2;  ///< the mesh level whose vertices the similarity fit uses (capped at L)
   MomentsOptions moments;
@@ -147,6 +151,8 @@ struct SegmentResult {
   IntensityWindow window;
   int self_intersections = -1; ///< -1 when not counted
   std::string force;           ///< "profile" or "step_edge"
+  /// profile_step_residual of the model's appearance (appearance.h); +infinity without one.
+  double profile_step_residual = std::numeric_limits<double>::infinity();
   std::vector<std::pair<std::string, double>> stage_seconds;
   double compute_seconds = 0;  ///< everything after loading, without the final self-intersection count
 };

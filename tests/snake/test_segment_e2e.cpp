@@ -262,11 +262,21 @@ TEST(SegmentCommand, SynthBuildModelWithImageThenSegment) {
                                             "/blob.model -o " + d + "/seg --truth " + d + "/tgt/truth.nii.gz --json -q");
   ASSERT_EQ(s.exit_code, 0) << s.output;
   const nlohmann::json rep = nlohmann::json::parse(s.output);
-  EXPECT_EQ(rep["force"], "profile");  // the model has an appearance
+  // The model has an appearance, and what it learned is a clean step (a blob on a flat
+  // background): the automatic force is the step edge. --force profile still takes the profiles.
+  EXPECT_EQ(rep["force"], "step_edge");
+  EXPECT_LT(rep["profile_step_residual"].get<double>(), 0.2);
   EXPECT_EQ(rep["self_intersections"], 0);
   EXPECT_GE(rep["scores"]["dice"].get<double>(), 0.95);
   std::printf("build-model --image + segment: Dice %.4f ASSD %.3f mm\n", rep["scores"]["dice"].get<double>(),
               rep["scores"]["assd_mm"].get<double>());
+  const auto sp = mrsnake::test::run_mrsnake("segment --image " + d + "/tgt/image.nii.gz --model " + d +
+                                             "/blob.model -o " + d + "/seg-profile --force profile --truth " + d +
+                                             "/tgt/truth.nii.gz --json -q");
+  ASSERT_EQ(sp.exit_code, 0) << sp.output;
+  const nlohmann::json profile = nlohmann::json::parse(sp.output);
+  EXPECT_EQ(profile["force"], "profile");
+  EXPECT_GE(profile["scores"]["dice"].get<double>(), 0.95);
   std::filesystem::remove_all(dir);
 }
 

@@ -625,6 +625,47 @@ TEST(Forces, RingSharingAveragesNoiseButKeepsASharpMatchOfItsOwn) {
   for (int v = 0; v < n * n; ++v) EXPECT_EQ(none.offsets[v], own.offsets[v]);
 }
 
+TEST(Appearance, ProfileStepResidualTellsACleanStepFromAWrappedObject) {
+  // A sphere of radius 10 mm (bright, 1) on a dark background (0), and the same sphere
+  // wrapped in a 2 mm shell of intermediate intensity (0.5), with noise of sigma 0.2 (SNR 5).
+  // The profiles learned on the sphere's subdivided icosahedron must tell them apart.
+  const auto image_of = [](double shell_mm, std::uint32_t seed) {
+    Volume v = make_grid({40, 40, 40}, {1, 1, 1}, {-19.5, -19.5, -19.5}, Eigen::Matrix3d::Identity());
+    fill_object(v, [](const Eigen::Vector3d& p) { return p.norm() - 10.0; }, 1.0f, 0.0f);
+    if (shell_mm > 0) {
+      Volume shell = v;
+      fill_object(shell, [shell_mm](const Eigen::Vector3d& p) { return p.norm() - 10.0 - shell_mm; }, 0.5f, 0.0f);
+      for (std::size_t i = 0; i < v.data.size(); ++i) v.data[i] = std::max(v.data[i], shell.data[i]);
+    }
+    std::mt19937 rng(seed);
+    std::normal_distribution<float> noise(0.0f, 0.2f);
+    for (float& x : v.data) x += noise(rng);
+    return v;
+  };
+  std::vector<RowMatrixX3d> levels;
+  std::vector<RowMatrixX3i> faces;
+  for (int j = 0; j < 3; ++j) {
+    const TriMesh sphere = icosphere(j + 1, 10.0);
+    levels.push_back(sphere.V);
+    faces.push_back(sphere.F);
+  }
+  const auto residual = [&](const Volume& image) {
+    const Appearance a = build_appearance(build_pyramid(image, 3), levels, faces);
+    return profile_step_residual(a, faces);
+  };
+  const double clean = residual(image_of(0, 1)), wrapped = residual(image_of(2.0, 2));
+  // Measured 0.07 and 0.28, on either side of segment()'s threshold with a margin.
+  const double threshold = SegmentOptions{}.clean_step_max_residual;
+  EXPECT_LT(clean, 0.6 * threshold);
+  EXPECT_GT(wrapped, 1.2 * threshold);
+  // Levels and faces that do not match, or no contrast, give no verdict.
+  const Appearance a = build_appearance(build_pyramid(image_of(0, 3), 3), levels, faces);
+  EXPECT_TRUE(std::isinf(profile_step_residual(a, {faces[0]})));
+  Appearance flat = a;
+  flat.region.outside = flat.region.inside;
+  EXPECT_TRUE(std::isinf(profile_step_residual(flat, faces)));
+}
+
 TEST(Appearance, SerializationRoundTripsAndRejectsDamage) {
   Appearance a;
   a.half_length = 2;
