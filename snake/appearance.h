@@ -53,8 +53,9 @@ Appearance build_appearance(const std::vector<Volume>& pyramid, const std::vecto
 /// image's noise averages out) against the ideal step (region.inside before the surface,
 /// region.outside after it, their mean on it), as an RMS difference over the contrast
 /// |inside − outside|; the result is the largest, over the levels, of its 90th percentile.
-/// A two-intensity object scores ~0.05–0.1 (blur widens the finest level's step); an object
-/// wrapped in another tissue (the synthetic heart's wall) ~0.3, real CT and MRI 0.5 and more.
+/// Measured: blobs on a flat background 0.06–0.13 (mrsnake synth, SNR 8 and 4 references),
+/// a noisy sphere 0.07 and the same sphere in a shell 0.28 (the unit test), the synthetic
+/// heart inside its wall 0.38, real CT and MRI 0.56 and more.
 /// \return +infinity if there is no contrast, or faces do not match the levels.
 double profile_step_residual(const Appearance& appearance, const std::vector<RowMatrixX3i>& faces);
 

@@ -37,14 +37,17 @@ int best_candidate(const std::vector<double>& cost, int nc, double min_gain) {
     if (cost[c] < cost[best] || (cost[c] == cost[best] && std::abs(c - nc) < std::abs(best - nc))) best = c;
   return cost[best] < cost[nc] - min_gain ? best : nc;
 }
+// Row v: vertex v's costs of the candidates −nc..nc (row-major: the ring mixing reads whole rows).
+using CostMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
 // Per vertex, the best candidate of its cost curve (row v of `cost`, candidates −nc..nc at
 // spacing h), refined by a parabola; see NormalSearchOptions::ring_weight for the mixing with
 // the ring's curves first.
-SearchResult pick_offsets(const Eigen::MatrixXd& cost, int nc, double h, const NormalSearchOptions& options) {
+SearchResult pick_offsets(const CostMatrix& cost, int nc, double h, const NormalSearchOptions& options) {
   const int n = static_cast<int>(cost.rows());
   const int C = static_cast<int>(cost.cols());
   const VertexRings* rings = options.rings;
-  const bool mix = rings != nullptr && options.ring_weight > 0 && rings->num_vertices() == n;
+  const bool mix = rings != nullptr && options.ring_weight > 0 && rings->num_vertices() == n && C > 0;
   SearchResult r;
   r.offsets.setZero(n);
   r.costs.setZero(n);
@@ -55,12 +58,13 @@ SearchResult pick_offsets(const Eigen::MatrixXd& cost, int nc, double h, const N
     if (valence > 0) {
       // A sharp match of its own (low cost) keeps the vertex on its own evidence.
       const double own_best = *std::min_element(curve.begin(), curve.end());
-      const double w = options.ring_full_weight_cost > 0
-                           ? options.ring_weight * std::min(1.0, own_best / options.ring_full_weight_cost)
-                           : options.ring_weight;
-      for (double& c : curve) c *= 1.0 - w;
-      for (int k = rings->offsets[v]; k < rings->offsets[v + 1]; ++k)
-        for (int c = 0; c < C; ++c) curve[c] += (w / valence) * cost(rings->neighbors[k], c);
+      const double scale = options.ring_full_weight_cost > 0 ? std::min(1.0, own_best / options.ring_full_weight_cost) : 1.0;
+      const double w = std::clamp(options.ring_weight * scale, 0.0, 1.0);
+      if (w > 0) {
+        for (double& c : curve) c *= 1.0 - w;
+        for (int k = rings->offsets[v]; k < rings->offsets[v + 1]; ++k)
+          for (int c = 0; c < C; ++c) curve[c] += (w / valence) * cost(rings->neighbors[k], c);
+      }
     }
     const int best = best_candidate(curve, nc, options.min_gain);
     r.offsets[v] = curve[best] <= options.max_cost ? (best - nc) * h + refine(curve, best, h) : 0.0;
@@ -78,7 +82,7 @@ SearchResult search_step_edges(const VolumeSampler& image, const RowMatrixX3d& V
   const int ns = 2 * (nc + w);  // samples at offsets (s − nc − w + 0.5)·h, s = 0..ns−1
   const double contrast2 = std::max(1e-12, (stats.inside - stats.outside) * (stats.inside - stats.outside));
   const double norm = 1.0 / (2.0 * w * contrast2);
-  Eigen::MatrixXd cost(V.rows(), 2 * nc + 1);
+  CostMatrix cost(V.rows(), 2 * nc + 1);
   std::vector<double> in_prefix(ns + 1), out_prefix(ns + 1);
   for (int v = 0; v < V.rows(); ++v) {
     const Eigen::Vector3d x = V.row(v), n = N.row(v);
@@ -112,8 +116,9 @@ SearchResult search_profiles(const VolumeSampler& image, const RowMatrixX3d& V, 
   const double h = profile_spacing_mm / sub;
   const int nc = std::max(0, static_cast<int>(std::floor(options.range_mm / h)));
   const int ns = 2 * nc + sub * (K - 1) + 1;  // samples at offsets (s − nc − sub·half)·h
-  // A flat learned profile carries no information: no boundary seen (cost 1, beyond any max_cost).
-  Eigen::MatrixXd cost = Eigen::MatrixXd::Ones(V.rows(), 2 * nc + 1);
+  // A flat learned profile carries no information: no boundary seen (cost 1, above the
+  // usual max_cost, so it stays put unless its ring's evidence says where to go).
+  CostMatrix cost = CostMatrix::Ones(V.rows(), 2 * nc + 1);
   std::vector<double> samples(ns), model(K);
   for (int v = 0; v < V.rows(); ++v) {
     // The learned profile, centred and scaled to unit norm.

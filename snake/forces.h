@@ -37,10 +37,14 @@ struct NormalSearchOptions {
   /// Evidence shared along the surface. With rings (the 1-rings of the surface, one per row
   /// of V), vertex v's cost curve becomes (1 − w_v)·own + w_v·(mean of its ring's curves)
   /// before its best candidate is taken, w_v = ring_weight·min(1, c_v/ring_full_weight_cost)
-  /// with c_v its own best cost (ring_full_weight_cost 0: w_v = ring_weight). Neighbours see
-  /// the same boundary a little to the side, so in noise their curves average the noise out
-  /// along the surface without blurring the boundary across it, as smoothing the image would;
-  /// a vertex with a sharp match of its own keeps it, so a real detail is not averaged away.
+  /// (clamped to [0, 1]) with c_v its own best cost (ring_full_weight_cost 0: w_v =
+  /// ring_weight). Neighbours see the same boundary a little to the side, so in noise their curves
+  /// average the noise out along the surface without blurring the boundary across it, as
+  /// smoothing the image would; a vertex with a sharp match of its own keeps it, so a real
+  /// detail is not averaged away. A neighbour that sees no boundary (a flat curve, 1 for
+  /// profiles) leaves the best candidate where it was but raises the mixed cost towards
+  /// max_cost, so that vertices next to no evidence move less: leaving such neighbours out
+  /// lowered the real liver's Dice from 0.9722 to 0.9681. SearchResult::costs are the mixed costs.
   const VertexRings* rings = nullptr;  ///< not owned; nullptr = each vertex on its own
   double ring_weight = 0.0;
   double ring_full_weight_cost = 0.0;

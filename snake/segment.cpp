@@ -122,25 +122,27 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   const int L = model.finest_level();
   if (L < 0 || static_cast<int>(model.levels.size()) != L + 1 || !model.synthesize)
     throw InputError("the model has no usable levels; rebuild it with mrsnake build-model");
-  // Automatic: the profiles, unless what they learned is a clean step between two
-  // intensities; there the step-edge force, which fits the step at sub-voxel precision on
-  // every level, is both more accurate and faster (synthetic blobs at 128³: Dice
-  // 0.9941–0.9956 with profiles, 0.9956–0.9971 with the step).
-  const double step_residual =
-      model.appearance ? profile_step_residual(*model.appearance, model.connectivity.faces)
-                       : std::numeric_limits<double>::infinity();
-  const bool use_profiles = options.force == ForceMode::profile ||
-                            (options.force == ForceMode::automatic && model.appearance.has_value() &&
-                             !(step_residual <= options.clean_step_max_residual));
-  if (use_profiles) {
-    if (!model.appearance)
-      throw InputError("--force profile needs a model built with an appearance (build-model --image)");
+  // A stored appearance must match the levels before the profiles are used, and before the
+  // automatic choice reads them.
+  if (model.appearance && options.force != ForceMode::step_edge) {
     if (static_cast<int>(model.appearance->levels.size()) != L + 1)
       throw InputError("the model's appearance does not match its levels; rebuild the model");
     for (int j = 0; j <= L; ++j)
       if (model.appearance->levels[j].profiles.rows() != model.levels[j].rows())
         throw InputError("the model's appearance does not match its levels; rebuild the model");
   }
+  if (options.force == ForceMode::profile && !model.appearance)
+    throw InputError("--force profile needs a model built with an appearance (build-model --image)");
+  // Automatic: the profiles, unless what they learned is a clean step between two
+  // intensities; there the step-edge force, which fits the step at sub-voxel precision on
+  // every level, is both more accurate and faster (synthetic blobs at 128³: Dice
+  // 0.9941–0.9956 with profiles, 0.9956–0.9971 with the step).
+  const double step_residual = model.appearance && options.force == ForceMode::automatic
+                                   ? profile_step_residual(*model.appearance, model.connectivity.faces)
+                                   : std::numeric_limits<double>::infinity();
+  const bool use_profiles = options.force == ForceMode::profile ||
+                            (options.force == ForceMode::automatic && model.appearance.has_value() &&
+                             !(step_residual <= options.clean_step_max_residual));
   SegmentResult result;
   result.force = use_profiles ? "profile" : "step_edge";
   result.profile_step_residual = step_residual;

@@ -151,7 +151,8 @@ struct SegmentResult {
   IntensityWindow window;
   int self_intersections = -1; ///< -1 when not counted
   std::string force;           ///< "profile" or "step_edge"
-  /// profile_step_residual of the model's appearance (appearance.h); +infinity without one.
+  /// profile_step_residual of the model's appearance (appearance.h) when the force was
+  /// chosen automatically; +infinity otherwise.
   double profile_step_residual = std::numeric_limits<double>::infinity();
   std::vector<std::pair<std::string, double>> stage_seconds;
   double compute_seconds = 0;  ///< everything after loading, without the final self-intersection count

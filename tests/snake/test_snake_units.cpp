@@ -375,6 +375,25 @@ TEST(Model, MidpointFrameSynthesisFollowsASimilarity) {
   }
 }
 
+TEST(Initialize, ThresholdClassesMediansFromALatticeSampleMatchTheWholeBox) {
+  // A bright ball (2) on a dark background (-1) with noise of sigma 0.5: the two classes'
+  // medians are the two intensities, from every voxel of the box or from a lattice sample.
+  Volume image = make_grid({48, 48, 48}, {1, 1, 1}, {-23.5, -23.5, -23.5}, Eigen::Matrix3d::Identity());
+  fill_object(image, [](const Eigen::Vector3d& p) { return p.norm() - 12.0; }, 2.0f, -1.0f, 1);
+  std::mt19937 rng(5);
+  std::normal_distribution<float> noise(0.0f, 0.5f);
+  for (float& x : image.data) x += noise(rng);
+  const Volume smooth = downsample_by_two(image);
+  const std::array<long, 3> lo{2, 2, 2}, hi{45, 45, 45};
+  const ThresholdClasses all = threshold_classes(image, smooth, lo, hi, std::size_t{1} << 30);
+  const ThresholdClasses some = threshold_classes(image, smooth, lo, hi, 4000);  // stride 6
+  EXPECT_NEAR(all.upper_median, 2.0, 0.05);
+  EXPECT_NEAR(all.lower_median, -1.0, 0.05);
+  EXPECT_NEAR(some.upper_median, all.upper_median, 0.08);
+  EXPECT_NEAR(some.lower_median, all.lower_median, 0.05);
+  EXPECT_EQ(some.threshold, all.threshold);  // Otsu on the coarse image is not sampled
+}
+
 TEST(Initialize, MomentsRecoverAKnownSimilarity) {
   // Model: an ellipsoid with distinct axes. Image: the same ellipsoid under a known similarity.
   const Eigen::Vector3d axes(12, 8, 5);
@@ -573,8 +592,12 @@ TEST(Forces, RingSharingAveragesNoiseButKeepsASharpMatchOfItsOwn) {
 
   // 1. A plane boundary at x = 10.3 in strong noise (contrast 1, sigma 0.7): sharing the
   //    ring's evidence brings the offsets closer to the true 1.3 mm.
-  Volume noisy = make_grid({24, 18, 18}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
-  fill_object(noisy, [](const Eigen::Vector3d& p) { return p.x() - 10.3; }, 1.0f, 0.0f, 5);
+  const auto clean_plane_image = [] {
+    Volume v = make_grid({24, 18, 18}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
+    fill_object(v, [](const Eigen::Vector3d& p) { return p.x() - 10.3; }, 1.0f, 0.0f, 5);
+    return v;
+  };
+  Volume noisy = clean_plane_image();
   std::mt19937 rng(7);
   std::normal_distribution<float> noise(0.0f, 0.7f);
   for (float& x : noisy.data) x += noise(rng);
@@ -618,11 +641,15 @@ TEST(Forces, RingSharingAveragesNoiseButKeepsASharpMatchOfItsOwn) {
   EXPECT_GT(worst_fixed, 0.25);  // measured 0.32
   EXPECT_LT(worst_kept, 0.12);   // measured 0.08
 
-  // 3. Without rings (or with a weight of 0) the result is each vertex's own, exactly.
-  NormalSearchOptions zero = shared;
-  zero.ring_weight = 0;
-  const SearchResult none = search_step_edges(c, V, N, RegionStats{1.0, 0.0}, zero);
-  for (int v = 0; v < n * n; ++v) EXPECT_EQ(none.offsets[v], own.offsets[v]);
+  // 3. The profile search shares the same way: profiles learned on the clean boundary,
+  //    matched in the noisy image.
+  RowMatrixX3d on = V;
+  on.col(0).setConstant(10.3);
+  const Eigen::MatrixXf learned = sample_profiles(VolumeSampler(clean_plane_image()), on, N, 5, 1.0);
+  const double profile_alone = rms_error(search_profiles(s, V, N, learned, 1.0, alone));
+  const double profile_shared = rms_error(search_profiles(s, V, N, learned, 1.0, scaled));
+  EXPECT_GT(profile_alone, 0.3);
+  EXPECT_LT(profile_shared, 0.8 * profile_alone) << profile_alone;
 }
 
 TEST(Appearance, ProfileStepResidualTellsACleanStepFromAWrappedObject) {
