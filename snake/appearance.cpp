@@ -175,7 +175,8 @@ double profile_step_residual(const Appearance& a, const std::vector<RowMatrixX3i
   for (std::size_t j = 0; j < a.levels.size(); ++j) {
     const auto& P = a.levels[j].profiles;
     const int n = static_cast<int>(P.rows()), K = static_cast<int>(P.cols()), half = K / 2;
-    if (n == 0 || K == 0 || (faces[j].size() > 0 && (faces[j].maxCoeff() >= n || faces[j].minCoeff() < 0))) return std::numeric_limits<double>::infinity();
+    const bool faces_fit = faces[j].size() == 0 || (faces[j].minCoeff() >= 0 && faces[j].maxCoeff() < n);
+    if (n == 0 || K == 0 || !faces_fit) return std::numeric_limits<double>::infinity();
     const VertexRings rings = build_vertex_rings(faces[j], n);
     residuals.clear();
     mean.assign(static_cast<std::size_t>(K), 0.0);

@@ -37,6 +37,7 @@ int best_candidate(const std::vector<double>& cost, int nc, double min_gain) {
     if (cost[c] < cost[best] || (cost[c] == cost[best] && std::abs(c - nc) < std::abs(best - nc))) best = c;
   return cost[best] < cost[nc] - min_gain ? best : nc;
 }
+
 // Row v: vertex v's costs of the candidates −nc..nc (row-major: the ring mixing reads whole rows).
 using CostMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
