@@ -66,6 +66,13 @@ void fill_object(Volume& v, Phi phi, float in, float out, int n = 3) {
       }
 }
 
+// Adds Gaussian noise of the given sigma to every voxel, reproducibly (seeded).
+void add_noise(Volume& v, float sigma, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> noise(0.0f, sigma);
+  for (float& x : v.data) x += noise(rng);
+}
+
 // The faces of an n × n grid of vertices (vertex y·n + x), each square split along the same
 // diagonal: valence 6 inside.
 RowMatrixX3i grid_faces(int n) {
@@ -380,9 +387,7 @@ TEST(Initialize, ThresholdClassesMediansFromALatticeSampleMatchTheWholeBox) {
   // medians are the two intensities, from every voxel of the box or from a lattice sample.
   Volume image = make_grid({48, 48, 48}, {1, 1, 1}, {-23.5, -23.5, -23.5}, Eigen::Matrix3d::Identity());
   fill_object(image, [](const Eigen::Vector3d& p) { return p.norm() - 12.0; }, 2.0f, -1.0f, 1);
-  std::mt19937 rng(5);
-  std::normal_distribution<float> noise(0.0f, 0.5f);
-  for (float& x : image.data) x += noise(rng);
+  add_noise(image, 0.5f, 5);
   const Volume smooth = downsample_by_two(image);
   const std::array<long, 3> lo{2, 2, 2}, hi{45, 45, 45};
   const ThresholdClasses all = threshold_classes(image, smooth, lo, hi, std::size_t{1} << 30);
@@ -598,9 +603,7 @@ TEST(Forces, RingSharingAveragesNoiseButKeepsASharpMatchOfItsOwn) {
     return v;
   };
   Volume noisy = clean_plane_image();
-  std::mt19937 rng(7);
-  std::normal_distribution<float> noise(0.0f, 0.7f);
-  for (float& x : noisy.data) x += noise(rng);
+  add_noise(noisy, 0.7f, 7);
   const VolumeSampler s(noisy);
   const auto rms_error = [&](const SearchResult& r) {
     double sum = 0;
@@ -664,9 +667,7 @@ TEST(Appearance, ProfileStepResidualTellsACleanStepFromAWrappedObject) {
       fill_object(shell, [shell_mm](const Eigen::Vector3d& p) { return p.norm() - 10.0 - shell_mm; }, 0.5f, 0.0f);
       for (std::size_t i = 0; i < v.data.size(); ++i) v.data[i] = std::max(v.data[i], shell.data[i]);
     }
-    std::mt19937 rng(seed);
-    std::normal_distribution<float> noise(0.0f, 0.2f);
-    for (float& x : v.data) x += noise(rng);
+    add_noise(v, 0.2f, seed);
     return v;
   };
   std::vector<RowMatrixX3d> levels;
