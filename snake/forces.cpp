@@ -84,13 +84,13 @@ SearchResult search_step_edges(const VolumeSampler& image, const RowMatrixX3d& V
   const double contrast2 = std::max(1e-12, (stats.inside - stats.outside) * (stats.inside - stats.outside));
   const double norm = 1.0 / (2.0 * w * contrast2);
   CostMatrix cost(V.rows(), 2 * nc + 1);
-  std::vector<double> in_prefix(ns + 1), out_prefix(ns + 1);
+  std::vector<double> in_prefix(ns + 1), out_prefix(ns + 1), samples(ns);
   for (int v = 0; v < V.rows(); ++v) {
     const Eigen::Vector3d x = V.row(v), n = N.row(v);
+    image.values_along(x, n, (-nc - w + 0.5) * h, h, ns, samples.data());
     in_prefix[0] = out_prefix[0] = 0;
     for (int s = 0; s < ns; ++s) {
-      const double t = (s - nc - w + 0.5) * h;
-      const double I = image.value(x + t * n);
+      const double I = samples[s];
       in_prefix[s + 1] = in_prefix[s] + (I - stats.inside) * (I - stats.inside);
       out_prefix[s + 1] = out_prefix[s] + (I - stats.outside) * (I - stats.outside);
     }
@@ -135,7 +135,7 @@ SearchResult search_profiles(const VolumeSampler& image, const RowMatrixX3d& V, 
     const double inv = 1.0 / std::sqrt(norm2);
     for (double& m : model) m *= inv;
     const Eigen::Vector3d x = V.row(v), n = N.row(v);
-    for (int s = 0; s < ns; ++s) samples[s] = image.value(x + ((s - nc - sub * half) * h) * n);
+    image.values_along(x, n, (-nc - sub * half) * h, h, ns, samples.data());
     for (int c = 0; c <= 2 * nc; ++c) {
       double sum = 0, sum2 = 0, dot = 0;
       for (int k = 0; k < K; ++k) {

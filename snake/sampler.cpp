@@ -68,6 +68,41 @@ float VolumeSampler::value_at_index(const Eigen::Vector3d& idx) const {
   return static_cast<float>(scale_ * c.value() + offset_);
 }
 
+void VolumeSampler::values_along(const Eigen::Vector3d& p, const Eigen::Vector3d& direction, double t0, double dt,
+                                 int count, double* out) const {
+  if (count <= 0) return;
+  const Eigen::Vector3d start = to_index(p), step = A_ * direction;
+  const Eigen::Vector3d first = start + t0 * step, last = start + (t0 + (count - 1) * dt) * step;
+  // Inside the cells of the image on every axis at both ends, so at every point between them
+  // (a segment is convex): the base index needs no clamping. An axis of one voxel always clamps.
+  const auto within = [](double a, double b, long n) {
+    return n > 1 && a >= 0.0 && b >= 0.0 && a < static_cast<double>(n - 1) && b < static_cast<double>(n - 1);
+  };
+  const float* d = volume_->data.data();
+  if (!(within(first.x(), last.x(), nx_) && within(first.y(), last.y(), ny_) && within(first.z(), last.z(), nz_))) {
+    for (int s = 0; s < count; ++s) {
+      const TrilinearCell c = trilinear_cell(d, nx_, ny_, nz_, start + (t0 + s * dt) * step);
+      out[s] = static_cast<float>(scale_ * c.value() + offset_);
+    }
+    return;
+  }
+  const long sy = nx_, sz = nx_ * ny_;
+  for (int s = 0; s < count; ++s) {
+    const Eigen::Vector3d idx = start + (t0 + s * dt) * step;
+    // As trilinear_cell, without the clamps: 0 <= idx < n − 1 on each axis.
+    const long i = static_cast<long>(idx.x()), j = static_cast<long>(idx.y()), k = static_cast<long>(idx.z());
+    const double fx = idx.x() - static_cast<double>(i), fy = idx.y() - static_cast<double>(j),
+                 fz = idx.z() - static_cast<double>(k);
+    const float* c = d + i + j * sy + k * sz;
+    const double c000 = c[0], c100 = c[1], c010 = c[sy], c110 = c[sy + 1];
+    const double c001 = c[sz], c101 = c[sz + 1], c011 = c[sz + sy], c111 = c[sz + sy + 1];
+    const double c00 = c000 + fx * (c100 - c000), c10 = c010 + fx * (c110 - c010);
+    const double c01 = c001 + fx * (c101 - c001), c11 = c011 + fx * (c111 - c011);
+    const double c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
+    out[s] = static_cast<float>(scale_ * (c0 + fz * (c1 - c0)) + offset_);
+  }
+}
+
 float VolumeSampler::value_and_gradient(const Eigen::Vector3d& p, Eigen::Vector3d& gradient) const {
   const Eigen::Vector3d idx = to_index(p);
   const TrilinearCell c = trilinear_cell(volume_->data.data(), nx_, ny_, nz_, idx);

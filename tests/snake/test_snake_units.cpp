@@ -117,6 +117,39 @@ TEST(Sampler, ExactOnALinearImageWithObliqueDirection) {
   EXPECT_NEAR(s.value({far[0], far[1], far[2]}), s.value({edge[0], edge[1], edge[2]}), 1e-4);
 }
 
+// The line sampler of the searches must give value() at every point: inside (the fast path
+// without clamps), across the border and along the last voxel plane (the clamped path), on
+// a random image with an oblique direction and anisotropic spacing.
+TEST(Sampler, ValuesAlongALineMatchValueAtEachPoint) {
+  Volume v = make_grid({9, 8, 7}, {0.7, 1.1, 1.9}, {3, -2, 5}, rotation(30, {1, 2, 3}));
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> noise(-3.0f, 7.0f);
+  for (float& x : v.data) x = noise(rng);
+  const VolumeSampler s(v, 0.5, 2.0);
+  const auto at = [&](double i, double j, double k) {
+    const auto p = v.index_to_physical(i, j, k);
+    return Eigen::Vector3d(p[0], p[1], p[2]);
+  };
+  struct Line {
+    Eigen::Vector3d from, to;
+  };
+  const std::vector<Line> lines{{at(1.2, 1.7, 1.1), at(6.9, 5.3, 4.8)},   // inside
+                                {at(-2.0, 3.5, 2.5), at(10.5, 3.5, 2.5)},  // through two faces
+                                {at(8.0, 2.2, 3.3), at(8.0, 6.1, 5.2)},    // on the last x plane
+                                {at(4.4, 3.3, 2.2), at(4.4, 3.3, 2.2)}};   // zero direction
+  for (const Line& line : lines) {
+    const Eigen::Vector3d dir = line.to - line.from;
+    const int count = 23;
+    const double t0 = -0.25, dt = 1.5 / (count - 1);
+    std::vector<double> out(count, -99.0);
+    s.values_along(line.from, dir, t0, dt, count, out.data());
+    for (int k = 0; k < count; ++k) EXPECT_NEAR(out[k], s.value(line.from + (t0 + k * dt) * dir), 1e-5) << k;
+  }
+  std::vector<double> none(1, -99.0);
+  s.values_along(lines[0].from, lines[0].to, 0.0, 1.0, 0, none.data());
+  EXPECT_EQ(none[0], -99.0);
+}
+
 TEST(Pyramid, DownsamplingKeepsPhysicalPositions) {
   const Eigen::Matrix3d D = rotation(20, {0, 1, 1});
   Volume v = make_grid({16, 12, 9}, {1.0, 0.5, 2.0}, {1, 2, 3}, D);
