@@ -5,23 +5,28 @@
 namespace mrsnake {
 
 VertexRings build_vertex_rings(const RowMatrixX3i& F, int n) {
-  std::vector<std::vector<int>> adj(static_cast<std::size_t>(n));
+  // Each face lists its other two corners at each corner (an interior edge twice), in one
+  // flat array bucketed by vertex; each bucket is then sorted, deduplicated and compacted.
+  std::vector<int> start(static_cast<std::size_t>(n) + 1, 0);
+  for (int f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) start[F(f, c) + 1] += 2;
+  for (int v = 0; v < n; ++v) start[v + 1] += start[v];
+  std::vector<int> listed(static_cast<std::size_t>(start[n])), fill(start.begin(), start.end() - 1);
   for (int f = 0; f < F.rows(); ++f)
     for (int c = 0; c < 3; ++c) {
-      const int a = F(f, c), b = F(f, (c + 1) % 3);
-      adj[a].push_back(b);
-      adj[b].push_back(a);
+      const int v = F(f, c);
+      listed[fill[v]++] = F(f, (c + 1) % 3);
+      listed[fill[v]++] = F(f, (c + 2) % 3);
     }
   VertexRings rings;
   rings.offsets.resize(static_cast<std::size_t>(n) + 1, 0);
+  rings.neighbors.reserve(listed.size() / 2);
   for (int v = 0; v < n; ++v) {
-    auto& a = adj[v];
-    std::sort(a.begin(), a.end());
-    a.erase(std::unique(a.begin(), a.end()), a.end());
-    rings.offsets[v + 1] = rings.offsets[v] + static_cast<int>(a.size());
+    const auto begin = listed.begin() + start[v], end = listed.begin() + start[v + 1];
+    std::sort(begin, end);
+    rings.neighbors.insert(rings.neighbors.end(), begin, std::unique(begin, end));
+    rings.offsets[v + 1] = static_cast<int>(rings.neighbors.size());
   }
-  rings.neighbors.reserve(static_cast<std::size_t>(rings.offsets[n]));
-  for (int v = 0; v < n; ++v) rings.neighbors.insert(rings.neighbors.end(), adj[v].begin(), adj[v].end());
   return rings;
 }
 
@@ -59,22 +64,33 @@ void smooth_on_rings(const VertexRings& rings, Eigen::VectorXd& values, int pass
   }
 }
 
+namespace {
+// The m-th smallest of w[0..n−1] (0-based) by counting ranks: without branches on the
+// values, which a sort of a 7-value ring mispredicts at every step.
+double order_statistic(const double* w, int n, int m) {
+  for (int i = 0; i < n; ++i) {
+    int less = 0, less_or_equal = 0;
+    for (int j = 0; j < n; ++j) {
+      less += w[j] < w[i];
+      less_or_equal += w[j] <= w[i];
+    }
+    if (less <= m && m < less_or_equal) return w[i];
+  }
+  return w[0];  // only with a NaN among the values: keep the vertex's own
+}
+}  // namespace
+
 void median_on_rings(const VertexRings& rings, Eigen::VectorXd& values, int passes) {
   Eigen::VectorXd tmp(values.size());
   std::vector<double> window;
   for (int p = 0; p < passes; ++p) {
     for (int v = 0; v < rings.num_vertices(); ++v) {
       window.assign(1, values[v]);
-      for (int k = rings.offsets[v]; k < rings.offsets[v + 1]; ++k) {  // insertion sort: rings are small
-        const double x = values[rings.neighbors[k]];
-        window.push_back(x);
-        std::size_t i = window.size() - 1;
-        for (; i > 0 && window[i - 1] > x; --i) window[i] = window[i - 1];
-        window[i] = x;
-      }
-      const std::size_t mid = window.size() / 2;
+      for (int k = rings.offsets[v]; k < rings.offsets[v + 1]; ++k) window.push_back(values[rings.neighbors[k]]);
+      const int n = static_cast<int>(window.size()), mid = n / 2;
       // An even window takes the mean of its two middle values.
-      tmp[v] = window.size() % 2 ? window[mid] : 0.5 * (window[mid - 1] + window[mid]);
+      tmp[v] = n % 2 ? order_statistic(window.data(), n, mid)
+                     : 0.5 * (order_statistic(window.data(), n, mid - 1) + order_statistic(window.data(), n, mid));
     }
     values.swap(tmp);
   }

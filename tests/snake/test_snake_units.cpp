@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <set>
 
 #include "mesh/distance.h"
 #include "mesh/errors.h"
@@ -366,6 +367,40 @@ TEST(Internal, RingMedianRemovesAnIsolatedOutlierThatTheMeanSpreads) {
   median_on_rings(rings, filtered, 1);
   EXPECT_LE(filtered.maxCoeff(), ramp.maxCoeff() + 1e-12);
   EXPECT_GE(filtered.minCoeff(), ramp.minCoeff() - 1e-12);
+}
+
+// Rings and ring medians against plain references: the sorted set of each vertex's edge
+// neighbours, and the median of a sorted copy of the closed ring, on an icosphere (valence
+// 5 and 6: even and odd windows) and an open grid (boundary rings), with many ties.
+TEST(Internal, RingsAndRingMediansMatchPlainReferences) {
+  const int n = 7;
+  const std::vector<TriMesh> meshes{icosphere(2, 10.0), TriMesh{RowMatrixX3d::Zero(n * n, 3), grid_faces(n)}};
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> level(0, 3);  // four values: ties in every ring
+  for (const TriMesh& m : meshes) {
+    const int nv = m.num_vertices();
+    std::vector<std::set<int>> expected(static_cast<std::size_t>(nv));
+    for (int f = 0; f < m.num_faces(); ++f)
+      for (int c = 0; c < 3; ++c) {
+        expected[m.F(f, c)].insert(m.F(f, (c + 1) % 3));
+        expected[m.F(f, (c + 1) % 3)].insert(m.F(f, c));
+      }
+    const VertexRings rings = build_vertex_rings(m.F, nv);
+    ASSERT_EQ(rings.num_vertices(), nv);
+    Eigen::VectorXd values(nv);
+    for (int v = 0; v < nv; ++v) values[v] = 0.5 * level(rng);
+    Eigen::VectorXd median = values;
+    median_on_rings(rings, median, 1);
+    for (int v = 0; v < nv; ++v) {
+      const std::vector<int> ring(rings.neighbors.begin() + rings.offsets[v], rings.neighbors.begin() + rings.offsets[v + 1]);
+      EXPECT_EQ(ring, std::vector<int>(expected[v].begin(), expected[v].end())) << v;
+      std::vector<double> window{values[v]};
+      for (int u : ring) window.push_back(values[u]);
+      std::sort(window.begin(), window.end());
+      const std::size_t mid = window.size() / 2;
+      EXPECT_EQ(median[v], window.size() % 2 ? window[mid] : 0.5 * (window[mid - 1] + window[mid])) << v;
+    }
+  }
 }
 
 TEST(Snake, UndoSelfIntersectionsRestoresAnIntersectionFreeSurface) {
