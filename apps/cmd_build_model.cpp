@@ -42,6 +42,7 @@ void add_build_model_command(CLI::App& app) {
     // by -0.0022..+0.0007 (docs/bench-segment.md, session 8). 0.5 buys triangle quality, and
     // the snake measured better with the denser sampling of the bends.
     double curvature_weight = 1.0;
+    std::string profile_alignment = "auto";
   };
   auto a = std::make_shared<Args>();
   cmd->add_option("--labels", a->labels, "Label volume (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)")->required();
@@ -75,6 +76,13 @@ void add_build_model_command(CLI::App& app) {
                   "Reference intensity image of the labels (same physical space): stores the appearance "
                   "(profiles along the normals, inside/outside statistics) that 'mrsnake segment' matches, and a "
                   "crop of the image around the organ that 'mrsnake segment --init register' registers to a new image");
+  cmd->add_option("--profile-alignment", a->profile_alignment,
+                  "Where the profiles of --image are centred: 'edges' (the image's edge within half a voxel of "
+                  "the label's surface: the label's rounding does not pass into the segmentations), 'labels' (the "
+                  "label's surface: the labels define the boundary, as an expert's on a real image), or 'auto' "
+                  "(edges when the profiles are clean steps, as in synthetic images)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "edges", "labels"}));
   cmd->add_option("--reference-margin", a->reference_margin_mm,
                   "Margin (mm) of the stored reference image crop around the organ (with --image)")
       ->capture_default_str()
@@ -158,10 +166,13 @@ void add_build_model_command(CLI::App& app) {
     report(progress, "wavelet analysis", 1.0);
     lap("analysis");
 
+    std::optional<ProfileAlignmentReport> alignment;
     if (!a->image.empty()) {
       report(progress, "appearance", 0.0);
       const Volume reference = read_volume(a->image);
-      add_appearance(model, reference);
+      AppearanceOptions appearance;
+      appearance.alignment = parse_profile_alignment(a->profile_alignment);
+      alignment = add_appearance(model, reference, appearance);
       ReferenceImageOptions ro;
       ro.margin_mm = a->reference_margin_mm;
       add_reference_image(model, reference, ro);
@@ -233,6 +244,7 @@ void add_build_model_command(CLI::App& app) {
                   {"closing_radius_voxels", surface.closing_radius},
                   {"finest_level_quality", quality["finest_level_quality"]},
                   {"detail_stats", stats},
+                  {"profile_alignment", alignment ? nlohmann::json(*alignment) : nlohmann::json()},
                   {"timings", stages},
                   {"total_seconds", total}});
       return;
@@ -240,6 +252,11 @@ void add_build_model_command(CLI::App& app) {
     std::cout << a->output << ": " << L << " levels, " << conn.vertex_counts.back() << " vertices and "
               << conn.faces.back().rows() << " faces at the finest level (input surface: " << surface.mesh.num_faces()
               << " faces)\n";
+    if (alignment)
+      std::printf("  profiles centred on the %s (step residual %.3f; %d levels moved, mean shift %+.3f mm, mean |shift| "
+                  "%.3f mm)\n",
+                  alignment->to_edges ? "image's edges" : "label's surface", alignment->step_residual,
+                  alignment->levels_aligned, alignment->mean_shift_mm, alignment->mean_abs_shift_mm);
     std::cout << "  level  detail rms (mm)  detail max (mm)\n";
     for (const DetailStats& s : model.detail_stats) std::printf("  %5d  %15.4g  %15.4g\n", s.level, s.rms, s.max);
     std::fflush(stdout);

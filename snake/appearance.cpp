@@ -51,15 +51,49 @@ void median_and_spread(std::vector<float>& a, double& median, double& spread) {
 }
 }  // namespace
 
+namespace {
+// Per vertex, the offset along its normal of the image's edge: on the mean profile of its
+// closed 1-ring (P sampled at `spacing`), the crossing of the mid level between the samples
+// two steps in and out that lies nearest the centre; then one ring average, and the clamp.
+// A vertex without such a crossing (no step there) keeps offset 0.
+Eigen::VectorXd edge_offsets(const Eigen::MatrixXf& P, const VertexRings& rings, double spacing, double limit) {
+  const int n = static_cast<int>(P.rows()), K = static_cast<int>(P.cols()), half = K / 2;
+  Eigen::VectorXd offsets = Eigen::VectorXd::Zero(n);
+  if (half < 2) return offsets;
+  std::vector<double> mean(static_cast<std::size_t>(K));
+  for (int v = 0; v < n; ++v) {
+    for (int k = 0; k < K; ++k) mean[k] = P(v, k);
+    for (int i = rings.offsets[v]; i < rings.offsets[v + 1]; ++i)
+      for (int k = 0; k < K; ++k) mean[k] += P(rings.neighbors[i], k);
+    const double mid = 0.5 * (mean[half - 2] + mean[half + 2]);
+    if (!(std::abs(mean[half - 2] - mean[half + 2]) > 1e-9)) continue;
+    double nearest = std::numeric_limits<double>::infinity();  // in samples from the centre
+    for (int k = half - 2; k < half + 2; ++k) {
+      const double y0 = mean[k] - mid, y1 = mean[k + 1] - mid;
+      if ((y0 <= 0 && y1 > 0) || (y0 >= 0 && y1 < 0)) {
+        const double t = (k - half) + y0 / (y0 - y1);
+        if (std::abs(t) < std::abs(nearest)) nearest = t;
+      }
+    }
+    if (std::isfinite(nearest)) offsets[v] = nearest * spacing;
+  }
+  smooth_on_rings(rings, offsets, 1);
+  return offsets.cwiseMax(-limit).cwiseMin(limit);
+}
+}  // namespace
+
 Appearance build_appearance(const std::vector<Volume>& pyramid, const std::vector<RowMatrixX3d>& levels,
-                            const std::vector<RowMatrixX3i>& faces, const AppearanceOptions& options) {
+                            const std::vector<RowMatrixX3i>& faces, const AppearanceOptions& options,
+                            ProfileAlignmentReport* alignment) {
   Appearance a;
   a.half_length = options.half_length;
   std::vector<double> spacings;
   for (const Volume& v : pyramid) spacings.push_back(max_spacing(v));
   RowMatrixX3d N;
+  std::vector<int> pyramid_levels;
   for (std::size_t j = 0; j < levels.size(); ++j) {
     const int p = pyramid_level_for_edge(mean_edge_length(levels[j], faces[j]), spacings);
+    pyramid_levels.push_back(p);
     const VolumeSampler sampler(pyramid[p]);
     vertex_normals(levels[j], faces[j], N);
     LevelAppearance la;
@@ -84,7 +118,61 @@ Appearance build_appearance(const std::vector<Volume>& pyramid, const std::vecto
   }
   median_and_spread(in, a.region.inside, a.inside_spread);
   median_and_spread(out, a.region.outside, a.outside_spread);
+
+  ProfileAlignmentReport report;
+  report.step_residual = profile_step_residual(a, faces);
+  report.to_edges = options.alignment == ProfileAlignment::edges ||
+                    (options.alignment == ProfileAlignment::automatic && report.step_residual <= options.clean_edge_max_residual);
+  if (report.to_edges) {
+    // Only the levels sampled at full resolution: the label's rounding is below a coarser
+    // level's sampling, and a coarse level lies off the surface by more than that anyway.
+    const VolumeSampler sampler(pyramid[0]);
+    const double limit = options.max_alignment_voxels * spacings[0];
+    long count = 0;
+    for (std::size_t j = 0; j < levels.size(); ++j) {
+      if (pyramid_levels[j] != 0) continue;
+      const int n = static_cast<int>(levels[j].rows());
+      LevelAppearance& la = a.levels[j];
+      const Eigen::VectorXd shift = edge_offsets(la.profiles, build_vertex_rings(faces[j], n), la.spacing_mm, limit);
+      vertex_normals(levels[j], faces[j], N);
+      const RowMatrixX3d centres = levels[j] + shift.asDiagonal() * N;
+      la.profiles = sample_profiles(sampler, centres, N, options.half_length, la.spacing_mm);
+      ++report.levels_aligned;
+      report.mean_shift_mm += shift.sum();
+      report.mean_abs_shift_mm += shift.cwiseAbs().sum();
+      count += n;
+    }
+    if (count > 0) {
+      report.mean_shift_mm /= static_cast<double>(count);
+      report.mean_abs_shift_mm /= static_cast<double>(count);
+    }
+  }
+  if (alignment) *alignment = report;
   return a;
+}
+
+ProfileAlignment parse_profile_alignment(const std::string& name) {
+  if (name == "auto") return ProfileAlignment::automatic;
+  if (name == "edges") return ProfileAlignment::edges;
+  if (name == "labels") return ProfileAlignment::labels;
+  throw InputError("unknown profile alignment '" + name + "'; use auto, edges or labels");
+}
+
+const char* to_string(ProfileAlignment alignment) {
+  switch (alignment) {
+    case ProfileAlignment::automatic: return "auto";
+    case ProfileAlignment::edges: return "edges";
+    case ProfileAlignment::labels: return "labels";
+  }
+  return "auto";
+}
+
+void to_json(nlohmann::json& j, const ProfileAlignmentReport& r) {
+  j = nlohmann::json{{"centred_on", r.to_edges ? "edges" : "labels"},
+                     {"step_residual", std::isfinite(r.step_residual) ? nlohmann::json(r.step_residual) : nlohmann::json()},
+                     {"levels_aligned", r.levels_aligned},
+                     {"mean_shift_mm", r.mean_shift_mm},
+                     {"mean_abs_shift_mm", r.mean_abs_shift_mm}};
 }
 
 namespace {

@@ -5,6 +5,7 @@
 /// intensity statistics inside the object and in a shell outside it. Intensities are those
 /// of the robustly normalized image (image_pyramid.h), so they compare across scans.
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json_fwd.hpp>
@@ -29,9 +30,41 @@ struct Appearance {
   double shell_mm = 0;             ///< thickness of the shells the statistics come from
 };
 
+/// Where each learned profile is centred along its normal.
+enum class ProfileAlignment {
+  /// edges when the profiles are clean steps (profile_step_residual at most
+  /// AppearanceOptions::clean_edge_max_residual), labels otherwise.
+  automatic,
+  /// On the image's edge near the vertex. The model's surface comes from a binary label,
+  /// whose boundary lies up to half a voxel from the object's true boundary, coherently over
+  /// a flat, axis-aligned region (the synthetic heart's base lies 0.1–0.2 mm inside its wall
+  /// on the model, and the segmentations inherited it through the profiles).
+  edges,
+  /// On the label's surface: the labels define the boundary. On real images an expert's
+  /// boundary need not be the intensity midpoint (aligning to edges lowered the Dice of the
+  /// real liver 0.9722 → 0.9662 and the left hippocampus 0.9531 → 0.9143).
+  labels,
+};
+
 struct AppearanceOptions {
   int half_length = 5;
   double shell_voxels = 3;  ///< statistics shell thickness, in voxels of the full-resolution image
+  ProfileAlignment alignment = ProfileAlignment::automatic;
+  /// automatic: the largest step residual of profiles still taken for a clean step. Measured
+  /// residuals: synthetic blobs 0.06–0.13, the synthetic heart 0.38, real CT and MRI ≥ 0.56.
+  double clean_edge_max_residual = 0.5;
+  /// edges: the largest shift of a profile's centre, in voxels of the full-resolution image
+  /// (the label's rounding is at most half a voxel).
+  double max_alignment_voxels = 0.5;
+};
+
+/// What build_appearance did about ProfileAlignment.
+struct ProfileAlignmentReport {
+  bool to_edges = false;  ///< the profiles were centred on the image's edges
+  double step_residual = 0;  ///< profile_step_residual of the profiles at the label's surface
+  int levels_aligned = 0;    ///< levels whose profiles use the full-resolution image (only these move)
+  double mean_shift_mm = 0;      ///< over the vertices of the aligned levels, + outwards
+  double mean_abs_shift_mm = 0;
 };
 
 /// Picks the pyramid level for a mesh level: the one whose largest voxel size is closest
@@ -44,9 +77,21 @@ double mean_edge_length(const RowMatrixX3d& V, const RowMatrixX3i& F);
 
 /// Learns the appearance of every level S_j (faces F_j, in the reference image's physical
 /// space) from the normalized reference image's pyramid (pyramid[0] full resolution).
+/// With ProfileAlignment::edges (or automatic on clean steps), the profiles of the levels
+/// sampled at full resolution are centred on the image's edge: per vertex, the crossing of
+/// the mid level between the samples two voxels in and out on its closed 1-ring's mean
+/// profile, averaged once over the ring and clamped to max_alignment_voxels. What was done
+/// goes to *alignment when given.
 /// \pre levels.size() == faces.size(); pyramid not empty.
 Appearance build_appearance(const std::vector<Volume>& pyramid, const std::vector<RowMatrixX3d>& levels,
-                            const std::vector<RowMatrixX3i>& faces, const AppearanceOptions& options = {});
+                            const std::vector<RowMatrixX3i>& faces, const AppearanceOptions& options = {},
+                            ProfileAlignmentReport* alignment = nullptr);
+
+/// Parses "auto", "edges" or "labels".
+/// \throw InputError for any other name.
+ProfileAlignment parse_profile_alignment(const std::string& name);
+const char* to_string(ProfileAlignment alignment);
+void to_json(nlohmann::json& j, const ProfileAlignmentReport& r);
 
 /// How far the learned profiles are from a clean step between the region medians: per
 /// vertex of level j (faces[j]), the mean profile of its closed 1-ring (so that the reference

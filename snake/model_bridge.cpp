@@ -38,13 +38,16 @@ SnakeModel snake_model_from(const ShapeModel& model) {
   return m;
 }
 
-void add_appearance(ShapeModel& model, const Volume& reference_image, const AppearanceOptions& options) {
+ProfileAlignmentReport add_appearance(ShapeModel& model, const Volume& reference_image,
+                                      const AppearanceOptions& options) {
   Volume normalized = reference_image;
   normalize_intensities(normalized);
   const std::vector<RowMatrixX3d> levels = model_levels(model);
   const SubdivisionConnectivity conn = model.connectivity();
-  const Appearance a = build_appearance(build_pyramid(normalized, 8), levels, conn.faces, options);
+  ProfileAlignmentReport alignment;
+  const Appearance a = build_appearance(build_pyramid(normalized, 8), levels, conn.faces, options, &alignment);
   model.sections[kAppearanceSection] = serialize_appearance(a);
+  return alignment;
 }
 
 void add_reference_image(ShapeModel& model, const Volume& reference_image, const ReferenceImageOptions& options) {

@@ -22,8 +22,10 @@ SnakeModel snake_model_from(const ShapeModel& model);
 
 /// Learns the appearance of every level from the reference image (in which the model's
 /// levels lie, in physical coordinates) and stores it in the model's "appearance" section.
+/// \return what was done about the profiles' alignment (AppearanceOptions::alignment).
 /// \throw InputError if the image is constant.
-void add_appearance(ShapeModel& model, const Volume& reference_image, const AppearanceOptions& options = {});
+ProfileAlignmentReport add_appearance(ShapeModel& model, const Volume& reference_image,
+                                      const AppearanceOptions& options = {});
 
 /// Stores the robustly normalized crop of the reference image around the model's finest
 /// level (snake/reference_image.h) in the model's "reference_image" section, for

@@ -762,6 +762,62 @@ TEST(Appearance, ProfileStepResidualTellsACleanStepFromAWrappedObject) {
   EXPECT_TRUE(std::isinf(profile_step_residual(flat, faces)));
 }
 
+// A model surface 0.3 mm inside the image's edge (as a label's rounding leaves it): centred on
+// the edges, the profiles of the full-resolution level move out by 0.3 mm and their centre
+// sample reads the midpoint; centred on the labels, they stay at the vertices. A shift beyond
+// half a voxel is clamped, and `automatic` takes the labels when the profiles are no step.
+TEST(Appearance, ProfilesCentredOnTheImagesEdgesUndoTheLabelsRounding) {
+  const auto sphere_image = [](double radius) {
+    Volume v = make_grid({40, 40, 40}, {1, 1, 1}, {-19.5, -19.5, -19.5}, Eigen::Matrix3d::Identity());
+    fill_object(v, [radius](const Eigen::Vector3d& p) { return p.norm() - radius; }, 1.0f, 0.0f, 7);
+    return v;
+  };
+  std::vector<RowMatrixX3d> levels;
+  std::vector<RowMatrixX3i> faces;
+  for (int j = 0; j < 3; ++j) {
+    const TriMesh sphere = icosphere(j + 1, 10.0);
+    levels.push_back(sphere.V);
+    faces.push_back(sphere.F);
+  }
+  const int finest = 2, half = AppearanceOptions{}.half_length;
+  const auto learn = [&](const Volume& image, ProfileAlignment alignment, ProfileAlignmentReport& report) {
+    AppearanceOptions o;
+    o.alignment = alignment;
+    return build_appearance(build_pyramid(image, 3), levels, faces, o, &report);
+  };
+  const Volume image = sphere_image(10.3);
+  ProfileAlignmentReport edges, labels, automatic;
+  const Appearance on_edges = learn(image, ProfileAlignment::edges, edges);
+  const Appearance on_labels = learn(image, ProfileAlignment::labels, labels);
+  const Appearance chosen = learn(image, ProfileAlignment::automatic, automatic);
+  ASSERT_TRUE(edges.to_edges);
+  EXPECT_GE(edges.levels_aligned, 1);
+  EXPECT_NEAR(edges.mean_shift_mm, 0.3, 0.08);
+  EXPECT_NEAR(edges.mean_abs_shift_mm, 0.3, 0.08);
+  EXPECT_FALSE(labels.to_edges);
+  EXPECT_EQ(labels.levels_aligned, 0);
+  EXPECT_EQ(labels.mean_abs_shift_mm, 0.0);
+  EXPECT_TRUE(automatic.to_edges);  // a clean step
+  EXPECT_LT(automatic.step_residual, AppearanceOptions{}.clean_edge_max_residual);
+  EXPECT_EQ(chosen.levels[finest].profiles, on_edges.levels[finest].profiles);
+  // The centre sample: the midpoint 0.5 on the edge, about 0.8 at the label's surface.
+  EXPECT_NEAR(on_edges.levels[finest].profiles.col(half).mean(), 0.5, 0.06);
+  EXPECT_GT(on_labels.levels[finest].profiles.col(half).mean(), 0.7);
+  RowMatrixX3d N;
+  vertex_normals(levels[finest], faces[finest], N);
+  EXPECT_EQ(on_labels.levels[finest].profiles,
+            sample_profiles(VolumeSampler(image), levels[finest], N, half, on_labels.levels[finest].spacing_mm));
+
+  ProfileAlignmentReport far;
+  learn(sphere_image(11.5), ProfileAlignment::edges, far);
+  EXPECT_NEAR(far.mean_abs_shift_mm, 0.5, 1e-9);  // clamped at half a voxel
+
+  ProfileAlignmentReport no_step;
+  learn(sphere_image(14.0), ProfileAlignment::automatic, no_step);  // bright on both sides of the surface
+  EXPECT_FALSE(no_step.to_edges);
+  EXPECT_EQ(no_step.mean_abs_shift_mm, 0.0);
+}
+
 TEST(Appearance, SerializationRoundTripsAndRejectsDamage) {
   Appearance a;
   a.half_length = 2;

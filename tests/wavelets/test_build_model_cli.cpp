@@ -130,6 +130,32 @@ TEST(BuildModelCli, BadInputsGetExitCodes) {
   EXPECT_EQ(run_mrsnake("-q build-model --labels " + (dir / "none.nii.gz").string() + " --label 3 -o " + model).exit_code, 3);
   EXPECT_EQ(run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --predict cubic").exit_code, 2);
   EXPECT_EQ(run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --levels 3 --faces 100").exit_code, 2);
+  const auto bad_alignment = run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --image " +
+                                         labels + " --profile-alignment middle");
+  EXPECT_EQ(bad_alignment.exit_code, 2) << bad_alignment.output;
+  EXPECT_NE(bad_alignment.output.find("--profile-alignment"), std::string::npos) << bad_alignment.output;
+  EXPECT_FALSE(std::filesystem::exists(model));
+}
+
+TEST(BuildModelCli, ProfileAlignmentIsChosenAndReported) {
+  // The label volume as its own image: a clean step, so `auto` centres the profiles on its edges.
+  const auto dir = scratch_dir("build-model-cli-alignment");
+  const std::string labels = write_ellipsoid_labels(dir);
+  const auto summary_of = [&](const std::string& name, const std::string& extra) {
+    const auto r = run_mrsnake("-q build-model --labels " + labels + " --label 3 --image " + labels + " -o " +
+                               (dir / name).string() + " --faces 2048 --json" + extra);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    return nlohmann::json::parse(r.output)["profile_alignment"];
+  };
+  const nlohmann::json automatic = summary_of("auto.model", ""), labels_kept = summary_of("labels.model", " --profile-alignment labels");
+  EXPECT_EQ(automatic["centred_on"], "edges");
+  EXPECT_GE(automatic["levels_aligned"].get<int>(), 1);
+  EXPECT_GT(automatic["mean_abs_shift_mm"].get<double>(), 0.0);
+  EXPECT_LE(automatic["mean_abs_shift_mm"].get<double>(), 0.5 * 1.25 + 1e-9);  // half the largest voxel side
+  EXPECT_LT(automatic["step_residual"].get<double>(), 0.5);
+  EXPECT_EQ(labels_kept["centred_on"], "labels");
+  EXPECT_EQ(labels_kept["levels_aligned"].get<int>(), 0);
+  EXPECT_EQ(labels_kept["step_residual"], automatic["step_residual"]);
 }
 
 TEST(BuildModelCli, CloseTunnelsMakesAGenusOneLabelModelable) {
