@@ -88,6 +88,19 @@ RowMatrixX3i grid_faces(int n) {
   return F;
 }
 
+// Icospheres of radius r subdivided 1..count times: the levels and faces of a small hierarchy
+// (vertex positions only; not nested) for learning appearances.
+std::pair<std::vector<RowMatrixX3d>, std::vector<RowMatrixX3i>> icosphere_levels(int count, double radius) {
+  std::vector<RowMatrixX3d> levels;
+  std::vector<RowMatrixX3i> faces;
+  for (int j = 0; j < count; ++j) {
+    const TriMesh sphere = icosphere(j + 1, radius);
+    levels.push_back(sphere.V);
+    faces.push_back(sphere.F);
+  }
+  return {levels, faces};
+}
+
 }  // namespace
 
 TEST(Sampler, ExactOnALinearImageWithObliqueDirection) {
@@ -738,13 +751,9 @@ TEST(Appearance, ProfileStepResidualTellsACleanStepFromAWrappedObject) {
     add_noise(v, 0.2f, seed);
     return v;
   };
-  std::vector<RowMatrixX3d> levels;
-  std::vector<RowMatrixX3i> faces;
-  for (int j = 0; j < 3; ++j) {
-    const TriMesh sphere = icosphere(j + 1, 10.0);
-    levels.push_back(sphere.V);
-    faces.push_back(sphere.F);
-  }
+  const auto spheres = icosphere_levels(3, 10.0);
+  const std::vector<RowMatrixX3d>& levels = spheres.first;
+  const std::vector<RowMatrixX3i>& faces = spheres.second;
   const auto residual = [&](const Volume& image) {
     const Appearance a = build_appearance(build_pyramid(image, 3), levels, faces);
     return profile_step_residual(a, faces);
@@ -772,13 +781,9 @@ TEST(Appearance, ProfilesCentredOnTheImagesEdgesUndoTheLabelsRounding) {
     fill_object(v, [radius](const Eigen::Vector3d& p) { return p.norm() - radius; }, 1.0f, 0.0f, 7);
     return v;
   };
-  std::vector<RowMatrixX3d> levels;
-  std::vector<RowMatrixX3i> faces;
-  for (int j = 0; j < 3; ++j) {
-    const TriMesh sphere = icosphere(j + 1, 10.0);
-    levels.push_back(sphere.V);
-    faces.push_back(sphere.F);
-  }
+  const auto spheres = icosphere_levels(3, 10.0);
+  const std::vector<RowMatrixX3d>& levels = spheres.first;
+  const std::vector<RowMatrixX3i>& faces = spheres.second;
   const int finest = 2, half = AppearanceOptions{}.half_length;
   const auto learn = [&](const Volume& image, ProfileAlignment alignment, ProfileAlignmentReport& report) {
     AppearanceOptions o;
