@@ -253,10 +253,11 @@ void add_build_model_command(CLI::App& app) {
               << conn.faces.back().rows() << " faces at the finest level (input surface: " << surface.mesh.num_faces()
               << " faces)\n";
     if (alignment)
-      std::printf("  profiles centred on the %s (step residual %.3f; %d levels moved, mean shift %+.3f mm, mean |shift| "
-                  "%.3f mm)\n",
+      std::printf("  profiles centred on the %s (step residual %.3f; %d level%s moved, mean shift %+.3f mm, mean "
+                  "|shift| %.3f mm)\n",
                   alignment->to_edges ? "image's edges" : "label's surface", alignment->step_residual,
-                  alignment->levels_aligned, alignment->mean_shift_mm, alignment->mean_abs_shift_mm);
+                  alignment->levels_aligned, alignment->levels_aligned == 1 ? "" : "s", alignment->mean_shift_mm,
+                  alignment->mean_abs_shift_mm);
     std::cout << "  level  detail rms (mm)  detail max (mm)\n";
     for (const DetailStats& s : model.detail_stats) std::printf("  %5d  %15.4g  %15.4g\n", s.level, s.rms, s.max);
     std::fflush(stdout);
