@@ -72,17 +72,18 @@ void add_build_model_command(CLI::App& app) {
                   "If the label's surface is not genus 0, close the label with radii up to this many voxels until it "
                   "is (as 'mrsnake mc --close-tunnels'); 0 = no repair")
       ->check(CLI::Range(0, 20));
-  cmd->add_option("--image", a->image,
+  auto* image_option = cmd->add_option("--image", a->image,
                   "Reference intensity image of the labels (same physical space): stores the appearance "
                   "(profiles along the normals, inside/outside statistics) that 'mrsnake segment' matches, and a "
                   "crop of the image around the organ that 'mrsnake segment --init register' registers to a new image");
   cmd->add_option("--profile-alignment", a->profile_alignment,
-                  "Where the profiles of --image are centred: 'edges' (the image's edge within half a voxel of "
+                  "Where the profiles of --image are centred: 'edges' (the image's edge within half a voxel step of "
                   "the label's surface: the label's rounding does not pass into the segmentations), 'labels' (the "
                   "label's surface: the labels define the boundary, as an expert's on a real image), or 'auto' "
                   "(edges when the profiles are clean steps, as in synthetic images)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"auto", "edges", "labels"}));
+      ->check(CLI::IsMember({"auto", "edges", "labels"}))
+      ->needs(image_option);
   cmd->add_option("--reference-margin", a->reference_margin_mm,
                   "Margin (mm) of the stored reference image crop around the organ (with --image)")
       ->capture_default_str()

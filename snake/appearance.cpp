@@ -54,12 +54,13 @@ void median_and_spread(std::vector<float>& a, double& median, double& spread) {
 namespace {
 // Per vertex, the offset along its normal of the image's edge: on the mean profile of its
 // closed 1-ring (P sampled at `spacing`), the crossing of the mid level between the samples
-// two steps in and out that lies nearest the centre; then one ring average, and the clamp.
-// A vertex without such a crossing (no step there) keeps offset 0.
-Eigen::VectorXd edge_offsets(const Eigen::MatrixXf& P, const VertexRings& rings, double spacing, double limit) {
+// two steps in and out that lies nearest the centre; then one ring average, and the clamp to
+// ±limits[v]. A vertex without such a crossing (no step there) keeps offset 0.
+// \pre P.cols() >= 5 (two samples on each side of the centre).
+Eigen::VectorXd edge_offsets(const Eigen::MatrixXf& P, const VertexRings& rings, double spacing,
+                             const Eigen::VectorXd& limits) {
   const int n = static_cast<int>(P.rows()), K = static_cast<int>(P.cols()), half = K / 2;
   Eigen::VectorXd offsets = Eigen::VectorXd::Zero(n);
-  if (half < 2) return offsets;
   std::vector<double> mean(static_cast<std::size_t>(K));
   for (int v = 0; v < n; ++v) {
     for (int k = 0; k < K; ++k) mean[k] = P(v, k);
@@ -78,7 +79,24 @@ Eigen::VectorXd edge_offsets(const Eigen::MatrixXf& P, const VertexRings& rings,
     if (std::isfinite(nearest)) offsets[v] = nearest * spacing;
   }
   smooth_on_rings(rings, offsets, 1);
-  return offsets.cwiseMax(-limit).cwiseMin(limit);
+  return offsets.cwiseMax(-limits).cwiseMin(limits);
+}
+
+// How far a binary label's boundary can lie from the object's along each unit normal, per
+// voxel rounding: half the largest of the voxel's axis steps projected on the normal (half a
+// voxel across an axis-aligned plane, less across an oblique one), times `voxels` halves.
+Eigen::VectorXd rounding_limits(const Volume& image, const RowMatrixX3d& N, double voxels) {
+  Eigen::VectorXd limits(N.rows());
+  for (int v = 0; v < N.rows(); ++v) {
+    double largest = 0;
+    for (int c = 0; c < 3; ++c) {  // axis c's unit vector is column c of the direction matrix
+      const double along =
+          image.direction[c] * N(v, 0) + image.direction[3 + c] * N(v, 1) + image.direction[6 + c] * N(v, 2);
+      largest = std::max(largest, std::abs(along) * image.spacing[c]);
+    }
+    limits[v] = voxels * largest;
+  }
+  return limits;
 }
 }  // namespace
 
@@ -121,20 +139,22 @@ Appearance build_appearance(const std::vector<Volume>& pyramid, const std::vecto
 
   ProfileAlignmentReport report;
   report.step_residual = profile_step_residual(a, faces);
-  report.to_edges = options.alignment == ProfileAlignment::edges ||
-                    (options.alignment == ProfileAlignment::automatic && report.step_residual <= options.clean_edge_max_residual);
+  const bool wanted = options.alignment == ProfileAlignment::edges ||
+                      (options.alignment == ProfileAlignment::automatic &&
+                       report.step_residual <= options.clean_edge_max_residual);
+  report.to_edges = wanted && options.half_length >= 2;  // the crossing needs two samples a side
   if (report.to_edges) {
     // Only the levels sampled at full resolution: the label's rounding is below a coarser
     // level's sampling, and a coarse level lies off the surface by more than that anyway.
     const VolumeSampler sampler(pyramid[0]);
-    const double limit = options.max_alignment_voxels * spacings[0];
     long count = 0;
     for (std::size_t j = 0; j < levels.size(); ++j) {
       if (pyramid_levels[j] != 0) continue;
       const int n = static_cast<int>(levels[j].rows());
       LevelAppearance& la = a.levels[j];
-      const Eigen::VectorXd shift = edge_offsets(la.profiles, build_vertex_rings(faces[j], n), la.spacing_mm, limit);
       vertex_normals(levels[j], faces[j], N);
+      const Eigen::VectorXd shift = edge_offsets(la.profiles, build_vertex_rings(faces[j], n), la.spacing_mm,
+                                                 rounding_limits(pyramid[0], N, options.max_alignment_voxels));
       const RowMatrixX3d centres = levels[j] + shift.asDiagonal() * N;
       la.profiles = sample_profiles(sampler, centres, N, options.half_length, la.spacing_mm);
       ++report.levels_aligned;
@@ -158,18 +178,10 @@ ProfileAlignment parse_profile_alignment(const std::string& name) {
   throw InputError("unknown profile alignment '" + name + "'; use auto, edges or labels");
 }
 
-const char* to_string(ProfileAlignment alignment) {
-  switch (alignment) {
-    case ProfileAlignment::automatic: return "auto";
-    case ProfileAlignment::edges: return "edges";
-    case ProfileAlignment::labels: return "labels";
-  }
-  return "auto";
-}
-
 void to_json(nlohmann::json& j, const ProfileAlignmentReport& r) {
   j = nlohmann::json{{"centred_on", r.to_edges ? "edges" : "labels"},
-                     {"step_residual", std::isfinite(r.step_residual) ? nlohmann::json(r.step_residual) : nlohmann::json()},
+                     {"step_residual",
+                      std::isfinite(r.step_residual) ? nlohmann::json(r.step_residual) : nlohmann::json()},
                      {"levels_aligned", r.levels_aligned},
                      {"mean_shift_mm", r.mean_shift_mm},
                      {"mean_abs_shift_mm", r.mean_abs_shift_mm}};

@@ -37,8 +37,8 @@ enum class ProfileAlignment {
   automatic,
   /// On the image's edge near the vertex. The model's surface comes from a binary label,
   /// whose boundary lies up to half a voxel from the object's true boundary, coherently over
-  /// a flat, axis-aligned region (the synthetic heart's base lies 0.1–0.2 mm inside its wall
-  /// on the model, and the segmentations inherited it through the profiles).
+  /// a flat, axis-aligned region (the synthetic heart's flat base lay 0.11 mm inside on its
+  /// 128³ model, and 0.21 mm inside on the segmentations, which inherited it through the profiles).
   edges,
   /// On the label's surface: the labels define the boundary. On real images an expert's
   /// boundary need not be the intensity midpoint (aligning to edges lowered the Dice of the
@@ -51,10 +51,11 @@ struct AppearanceOptions {
   double shell_voxels = 3;  ///< statistics shell thickness, in voxels of the full-resolution image
   ProfileAlignment alignment = ProfileAlignment::automatic;
   /// automatic: the largest step residual of profiles still taken for a clean step. Measured
-  /// residuals: synthetic blobs 0.06–0.13, the synthetic heart 0.38, real CT and MRI ≥ 0.56.
+  /// residuals: synthetic blobs 0.06–0.13, the synthetic hearts 0.32–0.38, real CT and MRI ≥ 0.56.
   double clean_edge_max_residual = 0.5;
-  /// edges: the largest shift of a profile's centre, in voxels of the full-resolution image
-  /// (the label's rounding is at most half a voxel).
+  /// edges: the largest shift of a profile's centre, in voxel steps of the full-resolution
+  /// image along the vertex normal (the largest axis step projected on it: a label's rounding
+  /// moves its boundary by at most half of that).
   double max_alignment_voxels = 0.5;
 };
 
@@ -79,9 +80,9 @@ double mean_edge_length(const RowMatrixX3d& V, const RowMatrixX3i& F);
 /// space) from the normalized reference image's pyramid (pyramid[0] full resolution).
 /// With ProfileAlignment::edges (or automatic on clean steps), the profiles of the levels
 /// sampled at full resolution are centred on the image's edge: per vertex, the crossing of
-/// the mid level between the samples two voxels in and out on its closed 1-ring's mean
-/// profile, averaged once over the ring and clamped to max_alignment_voxels. What was done
-/// goes to *alignment when given.
+/// the mid level between the samples two steps in and out on its closed 1-ring's mean
+/// profile, averaged once over the ring and clamped to max_alignment_voxels (none with
+/// half_length < 2). What was done goes to *alignment when given.
 /// \pre levels.size() == faces.size(); pyramid not empty.
 Appearance build_appearance(const std::vector<Volume>& pyramid, const std::vector<RowMatrixX3d>& levels,
                             const std::vector<RowMatrixX3i>& faces, const AppearanceOptions& options = {},
@@ -90,7 +91,8 @@ Appearance build_appearance(const std::vector<Volume>& pyramid, const std::vecto
 /// Parses "auto", "edges" or "labels".
 /// \throw InputError for any other name.
 ProfileAlignment parse_profile_alignment(const std::string& name);
-const char* to_string(ProfileAlignment alignment);
+/// Keys: centred_on ("edges" or "labels"), step_residual (null when infinite: no contrast),
+/// levels_aligned, mean_shift_mm, mean_abs_shift_mm.
 void to_json(nlohmann::json& j, const ProfileAlignmentReport& r);
 
 /// How far the learned profiles are from a clean step between the region medians: per

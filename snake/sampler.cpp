@@ -28,7 +28,8 @@ inline void split(double x, long n, long& i0, long& i1, double& f) {
     f = 0;
     return;
   }
-  x = std::clamp(x, 0.0, static_cast<double>(n - 1));
+  // (NaN goes to 0: a cast of NaN to an integer is undefined.)
+  x = x > 0.0 ? std::min(x, static_cast<double>(n - 1)) : 0.0;
   i0 = std::min(static_cast<long>(x), n - 2);
   i1 = i0 + 1;
   f = x - static_cast<double>(i0);
@@ -89,8 +90,10 @@ void VolumeSampler::values_along(const Eigen::Vector3d& p, const Eigen::Vector3d
   const long sy = nx_, sz = nx_ * ny_;
   for (int s = 0; s < count; ++s) {
     const Eigen::Vector3d idx = start + (t0 + s * dt) * step;
-    // As trilinear_cell, without the clamps: 0 <= idx < n − 1 on each axis.
-    const long i = static_cast<long>(idx.x()), j = static_cast<long>(idx.y()), k = static_cast<long>(idx.z());
+    // As trilinear_cell, without the clamps: 0 <= idx < n − 1 on each axis. (The min keeps the
+    // cell inside should a point round differently from the ends, e.g. with fused multiply-adds.)
+    const long i = std::min(static_cast<long>(idx.x()), nx_ - 2), j = std::min(static_cast<long>(idx.y()), ny_ - 2),
+               k = std::min(static_cast<long>(idx.z()), nz_ - 2);
     const double fx = idx.x() - static_cast<double>(i), fy = idx.y() - static_cast<double>(j),
                  fz = idx.z() - static_cast<double>(k);
     const float* c = d + i + j * sy + k * sz;

@@ -32,10 +32,11 @@ class VolumeSampler {
   float value_at_index(const Eigen::Vector3d& idx) const;
 
   /// The values at the points p + (t0 + s·dt)·direction, s = 0..count−1, each as value()
-  /// gives it, written to out[0..count−1]. One call per line: the searches along the normals
-  /// sample millions of points per segmentation, and here each point's index costs one
-  /// multiply-add, and the clamping is skipped when the whole segment lies inside the image.
-  /// \pre out holds count values; count >= 0.
+  /// gives it (rounded to float, then widened), written to out[0..count−1]; nothing when
+  /// count <= 0. One call per line: the searches along the normals sample millions of points
+  /// per segmentation, and here each point's index costs one multiply-add, and the clamping is
+  /// skipped when the whole segment lies inside the image.
+  /// \pre out holds max(count, 0) values.
   void values_along(const Eigen::Vector3d& p, const Eigen::Vector3d& direction, double t0, double dt, int count,
                     double* out) const;
 

@@ -65,8 +65,8 @@ void smooth_on_rings(const VertexRings& rings, Eigen::VectorXd& values, int pass
 }
 
 namespace {
-// The m-th smallest of w[0..n−1] (0-based) by counting ranks: without branches on the
-// values, which a sort of a 7-value ring mispredicts at every step.
+// The m-th smallest of w[0..n−1] (0-based) by counting ranks: the counting has no branch on
+// the values, whose comparisons a sort of a 7-value ring mispredicts at almost every step.
 double order_statistic(const double* w, int n, int m) {
   for (int i = 0; i < n; ++i) {
     int less = 0, less_or_equal = 0;

@@ -131,9 +131,10 @@ TEST(Sampler, ExactOnALinearImageWithObliqueDirection) {
   EXPECT_NEAR(s.value({far[0], far[1], far[2]}), s.value({edge[0], edge[1], edge[2]}), 1e-4);
 }
 
-// The line sampler of the searches must give value() at every point: inside (the fast path
-// without clamps), across the border and along the last voxel plane (the clamped path), on
-// a random image with an oblique direction and anisotropic spacing.
+// The line sampler of the searches must give value() at every point: inside the image (the
+// fast path without clamps: forwards, backwards, one point, an end just below the last voxel
+// plane), and across the border or along the last plane (the clamped path), on a random
+// image with an oblique direction and anisotropic spacing.
 TEST(Sampler, ValuesAlongALineMatchValueAtEachPoint) {
   Volume v = make_grid({9, 8, 7}, {0.7, 1.1, 1.9}, {3, -2, 5}, rotation(30, {1, 2, 3}));
   std::mt19937 rng(5);
@@ -146,22 +147,31 @@ TEST(Sampler, ValuesAlongALineMatchValueAtEachPoint) {
   };
   struct Line {
     Eigen::Vector3d from, to;
+    double t0, dt;
+    int count;
   };
-  const std::vector<Line> lines{{at(1.2, 1.7, 1.1), at(6.9, 5.3, 4.8)},   // inside
-                                {at(-2.0, 3.5, 2.5), at(10.5, 3.5, 2.5)},  // through two faces
-                                {at(8.0, 2.2, 3.3), at(8.0, 6.1, 5.2)},    // on the last x plane
-                                {at(4.4, 3.3, 2.2), at(4.4, 3.3, 2.2)}};   // zero direction
-  for (const Line& line : lines) {
+  const std::vector<Line> lines{
+      {at(1.2, 1.7, 1.1), at(6.9, 5.3, 4.8), 0.1, 0.8 / 22, 23},                 // inside
+      {at(1.2, 1.7, 1.1), at(6.9, 5.3, 4.8), 0.9, -0.8 / 22, 23},                // inside, backwards
+      {at(1.2, 1.7, 1.1), at(6.9, 5.3, 4.8), 0.5, 0.1, 1},                       // one point
+      {at(2.2, 3.1, 1.5), at(8.0 - 1e-9, 3.1, 1.5), 0.0, 1.0 / 22, 23},          // up to just below x = n − 1
+      {at(-2.0, 3.5, 2.5), at(10.5, 3.5, 2.5), -0.25, 1.5 / 22, 23},             // through two faces
+      {at(8.0, 2.2, 3.3), at(8.0, 6.1, 5.2), -0.25, 1.5 / 22, 23},               // on the last x plane
+      {at(4.4, 3.3, 2.2), at(4.4, 3.3, 2.2), -0.25, 1.5 / 22, 23}};              // zero direction
+  for (std::size_t l = 0; l < lines.size(); ++l) {
+    const Line& line = lines[l];
     const Eigen::Vector3d dir = line.to - line.from;
-    const int count = 23;
-    const double t0 = -0.25, dt = 1.5 / (count - 1);
-    std::vector<double> out(count, -99.0);
-    s.values_along(line.from, dir, t0, dt, count, out.data());
-    for (int k = 0; k < count; ++k) EXPECT_NEAR(out[k], s.value(line.from + (t0 + k * dt) * dir), 1e-5) << k;
+    std::vector<double> out(line.count, -99.0);
+    s.values_along(line.from, dir, line.t0, line.dt, line.count, out.data());
+    for (int k = 0; k < line.count; ++k)
+      EXPECT_NEAR(out[k], s.value(line.from + (line.t0 + k * line.dt) * dir), 1e-5) << "line " << l << ", point " << k;
   }
   std::vector<double> none(1, -99.0);
   s.values_along(lines[0].from, lines[0].to, 0.0, 1.0, 0, none.data());
   EXPECT_EQ(none[0], -99.0);
+  // A NaN point is clamped like any other outside point (to the first voxel), not read wildly.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(std::isfinite(s.value(Eigen::Vector3d(nan, 0.0, 0.0))));
 }
 
 TEST(Pyramid, DownsamplingKeepsPhysicalPositions) {
@@ -405,7 +415,8 @@ TEST(Internal, RingsAndRingMediansMatchPlainReferences) {
     Eigen::VectorXd median = values;
     median_on_rings(rings, median, 1);
     for (int v = 0; v < nv; ++v) {
-      const std::vector<int> ring(rings.neighbors.begin() + rings.offsets[v], rings.neighbors.begin() + rings.offsets[v + 1]);
+      const std::vector<int> ring(rings.neighbors.begin() + rings.offsets[v],
+                                  rings.neighbors.begin() + rings.offsets[v + 1]);
       EXPECT_EQ(ring, std::vector<int>(expected[v].begin(), expected[v].end())) << v;
       std::vector<double> window{values[v]};
       for (int u : ring) window.push_back(values[u]);
@@ -785,9 +796,11 @@ TEST(Appearance, ProfilesCentredOnTheImagesEdgesUndoTheLabelsRounding) {
   const std::vector<RowMatrixX3d>& levels = spheres.first;
   const std::vector<RowMatrixX3i>& faces = spheres.second;
   const int finest = 2, half = AppearanceOptions{}.half_length;
-  const auto learn = [&](const Volume& image, ProfileAlignment alignment, ProfileAlignmentReport& report) {
+  const auto learn = [&](const Volume& image, ProfileAlignment alignment, ProfileAlignmentReport& report,
+                         double clean_edge_max_residual = AppearanceOptions{}.clean_edge_max_residual) {
     AppearanceOptions o;
     o.alignment = alignment;
+    o.clean_edge_max_residual = clean_edge_max_residual;
     return build_appearance(build_pyramid(image, 3), levels, faces, o, &report);
   };
   const Volume image = sphere_image(10.3);
@@ -813,9 +826,21 @@ TEST(Appearance, ProfilesCentredOnTheImagesEdgesUndoTheLabelsRounding) {
   EXPECT_EQ(on_labels.levels[finest].profiles,
             sample_profiles(VolumeSampler(image), levels[finest], N, half, on_labels.levels[finest].spacing_mm));
 
+  // 1.5 mm out: every vertex is clamped at half its voxel step along the normal, from 0.29 mm
+  // (a diagonal normal) to 0.5 mm (an axis).
   ProfileAlignmentReport far;
   learn(sphere_image(11.5), ProfileAlignment::edges, far);
-  EXPECT_NEAR(far.mean_abs_shift_mm, 0.5, 1e-9);  // clamped at half a voxel
+  ASSERT_EQ(far.levels_aligned, 1);
+  double expected = 0;
+  for (int v = 0; v < N.rows(); ++v) expected += 0.5 * N.row(v).cwiseAbs().maxCoeff() / N.rows();
+  EXPECT_NEAR(far.mean_abs_shift_mm, expected, 1e-9);
+  EXPECT_NEAR(far.mean_shift_mm, expected, 1e-9);
+
+  // The same clean step above a stricter threshold: automatic keeps the labels.
+  ProfileAlignmentReport strict;
+  learn(image, ProfileAlignment::automatic, strict, 0.5 * automatic.step_residual);
+  EXPECT_FALSE(strict.to_edges);
+  EXPECT_EQ(strict.step_residual, automatic.step_residual);
 
   ProfileAlignmentReport no_step;
   learn(sphere_image(14.0), ProfileAlignment::automatic, no_step);  // bright on both sides of the surface

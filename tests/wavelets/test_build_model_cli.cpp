@@ -135,6 +135,10 @@ TEST(BuildModelCli, BadInputsGetExitCodes) {
   EXPECT_EQ(bad_alignment.exit_code, 2) << bad_alignment.output;
   EXPECT_NE(bad_alignment.output.find("--profile-alignment"), std::string::npos) << bad_alignment.output;
   EXPECT_FALSE(std::filesystem::exists(model));
+  const auto alignment_without_image =
+      run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --profile-alignment edges");
+  EXPECT_EQ(alignment_without_image.exit_code, 2) << alignment_without_image.output;
+  EXPECT_NE(alignment_without_image.output.find("--image"), std::string::npos) << alignment_without_image.output;
 }
 
 TEST(BuildModelCli, ProfileAlignmentIsChosenAndReported) {
