@@ -31,6 +31,14 @@ std::string write_ellipsoid_labels(const std::filesystem::path& dir) {
   return path;
 }
 
+/// `mrsnake -q build-model ARGS` must exit with exit_code, say `mentions`, and leave no model at `model`.
+void expect_refused(const std::string& args, int exit_code, const std::string& mentions, const std::string& model) {
+  const auto r = run_mrsnake("-q build-model " + args);
+  EXPECT_EQ(r.exit_code, exit_code) << args << "\n" << r.output;
+  EXPECT_NE(r.output.find(mentions), std::string::npos) << args << "\n" << r.output;
+  EXPECT_FALSE(std::filesystem::exists(model)) << args;
+}
+
 }  // namespace
 
 TEST(BuildModelCli, BuildsAModelThatModelInfoAccepts) {
@@ -130,15 +138,10 @@ TEST(BuildModelCli, BadInputsGetExitCodes) {
   EXPECT_EQ(run_mrsnake("-q build-model --labels " + (dir / "none.nii.gz").string() + " --label 3 -o " + model).exit_code, 3);
   EXPECT_EQ(run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --predict cubic").exit_code, 2);
   EXPECT_EQ(run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --levels 3 --faces 100").exit_code, 2);
-  const auto bad_alignment = run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --image " +
-                                         labels + " --profile-alignment middle");
-  EXPECT_EQ(bad_alignment.exit_code, 2) << bad_alignment.output;
-  EXPECT_NE(bad_alignment.output.find("--profile-alignment"), std::string::npos) << bad_alignment.output;
-  EXPECT_FALSE(std::filesystem::exists(model));
-  const auto alignment_without_image =
-      run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --profile-alignment edges");
-  EXPECT_EQ(alignment_without_image.exit_code, 2) << alignment_without_image.output;
-  EXPECT_NE(alignment_without_image.output.find("--image"), std::string::npos) << alignment_without_image.output;
+  expect_refused("--labels " + labels + " --label 3 -o " + model + " --image " + labels +
+                     " --profile-alignment middle",
+                 2, "--profile-alignment", model);
+  expect_refused("--labels " + labels + " --label 3 -o " + model + " --profile-alignment edges", 2, "--image", model);
 }
 
 TEST(BuildModelCli, ProfileAlignmentIsChosenAndReported) {
@@ -188,11 +191,8 @@ TEST(BuildModelCli, CloseTunnelsMakesAGenusOneLabelModelable) {
       << refused.output;
   EXPECT_FALSE(std::filesystem::exists(model));
   // Too small a radius leaves the tunnel open: still refused, with a hint.
-  const auto too_small =
-      run_mrsnake("-q build-model --labels " + labels + " --label 4 -o " + model + " --faces 2048 --close-tunnels 1");
-  EXPECT_EQ(too_small.exit_code, 3) << too_small.output;
-  EXPECT_NE(too_small.output.find("try a larger --close-tunnels"), std::string::npos) << too_small.output;
-  EXPECT_FALSE(std::filesystem::exists(model));
+  expect_refused("--labels " + labels + " --label 4 -o " + model + " --faces 2048 --close-tunnels 1", 3,
+                 "try a larger --close-tunnels", model);
 
   const auto built =
       run_mrsnake("-q build-model --labels " + labels + " --label 4 -o " + model + " --faces 2048 --close-tunnels 6 --json");
