@@ -52,6 +52,16 @@ void median_and_spread(std::vector<float>& a, double& median, double& spread) {
 }  // namespace
 
 namespace {
+// The sum of the profiles of v's closed 1-ring (v and its neighbours), into sum[0..K−1]: their
+// mean times valence + 1. In the mean, the reference image's noise averages out, and a
+// neighbouring tissue, coherent along the surface, does not.
+void closed_ring_profile_sum(const Eigen::MatrixXf& P, const VertexRings& rings, int v, std::vector<double>& sum) {
+  const int K = static_cast<int>(P.cols());
+  for (int k = 0; k < K; ++k) sum[k] = P(v, k);
+  for (int i = rings.offsets[v]; i < rings.offsets[v + 1]; ++i)
+    for (int k = 0; k < K; ++k) sum[k] += P(rings.neighbors[i], k);
+}
+
 // Per vertex, the offset along its normal of the image's edge: on the mean profile of its
 // closed 1-ring (P sampled at `spacing`), the crossing of the mid level between the samples
 // two steps in and out that lies nearest the centre; then one ring average, and the clamp to
@@ -63,9 +73,7 @@ Eigen::VectorXd edge_offsets(const Eigen::MatrixXf& P, const VertexRings& rings,
   Eigen::VectorXd offsets = Eigen::VectorXd::Zero(n);
   std::vector<double> mean(static_cast<std::size_t>(K));
   for (int v = 0; v < n; ++v) {
-    for (int k = 0; k < K; ++k) mean[k] = P(v, k);
-    for (int i = rings.offsets[v]; i < rings.offsets[v + 1]; ++i)
-      for (int k = 0; k < K; ++k) mean[k] += P(rings.neighbors[i], k);
+    closed_ring_profile_sum(P, rings, v, mean);  // a scaled mean: the crossing does not change
     const double mid = 0.5 * (mean[half - 2] + mean[half + 2]);
     if (!(std::abs(mean[half - 2] - mean[half + 2]) > 1e-9)) continue;
     double nearest = std::numeric_limits<double>::infinity();  // in samples from the centre
@@ -281,11 +289,7 @@ double profile_step_residual(const Appearance& a, const std::vector<RowMatrixX3i
     residuals.clear();
     mean.assign(static_cast<std::size_t>(K), 0.0);
     for (int v = 0; v < n; ++v) {
-      // The closed 1-ring's mean profile: the reference image's noise averages out, a
-      // neighbouring tissue (coherent along the surface) does not.
-      for (int k = 0; k < K; ++k) mean[k] = P(v, k);
-      for (int i = rings.offsets[v]; i < rings.offsets[v + 1]; ++i)
-        for (int k = 0; k < K; ++k) mean[k] += P(rings.neighbors[i], k);
+      closed_ring_profile_sum(P, rings, v, mean);  // divided by valence + 1 below
       double sum2 = 0;
       for (int k = 0; k < K; ++k) {
         const double ideal = k < half ? inside : (k > half ? outside : 0.5 * (inside + outside));
