@@ -81,10 +81,7 @@ void VolumeSampler::values_along(const Eigen::Vector3d& p, const Eigen::Vector3d
   };
   const float* d = volume_->data.data();
   if (!(within(first.x(), last.x(), nx_) && within(first.y(), last.y(), ny_) && within(first.z(), last.z(), nz_))) {
-    for (int s = 0; s < count; ++s) {
-      const TrilinearCell c = trilinear_cell(d, nx_, ny_, nz_, start + (t0 + s * dt) * step);
-      out[s] = static_cast<float>(scale_ * c.value() + offset_);
-    }
+    for (int s = 0; s < count; ++s) out[s] = value_at_index(start + (t0 + s * dt) * step);
     return;
   }
   const long sy = nx_, sz = nx_ * ny_;
