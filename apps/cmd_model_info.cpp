@@ -6,6 +6,8 @@
 
 #include "apps/cli.h"
 #include "mesh/errors.h"
+#include "snake/appearance.h"
+#include "snake/model_bridge.h"
 #include "snake/reference_image.h"
 #include "wavelets/model_io.h"
 
@@ -44,6 +46,9 @@ void add_model_info_command(CLI::App& app) {
     nlohmann::json reference = nullptr;
     if (const auto it = model.sections.find(kReferenceImageSection); it != model.sections.end())
       reference_image_to_json(reference, deserialize_reference_image(it->second));
+    nlohmann::json appearance = nullptr;
+    if (const auto it = model.sections.find(kAppearanceSection); it != model.sections.end())
+      appearance = deserialize_appearance(it->second);
     nlohmann::json synthesis = {{"level", model.levels()},
                                 {"max_error_mm", max_err},
                                 {"rms_error_mm", rms_err},
@@ -52,7 +57,8 @@ void add_model_info_command(CLI::App& app) {
                                 {"seconds", seconds},
                                 {"ok", ok}};
     if (*json) {
-      print_json({{"model", *model_path}, {"manifest", manifest}, {"synthesis", synthesis}, {"reference_image", reference}});
+      print_json({{"model", *model_path}, {"manifest", manifest}, {"synthesis", synthesis}, {"reference_image", reference},
+                  {"appearance", appearance}});
     } else {
       std::cout << *model_path << ": mrsnake model, format version " << manifest["format_version"] << '\n';
       if (!model.source_image.empty() || model.source_label)
@@ -95,6 +101,13 @@ void add_model_info_command(CLI::App& app) {
         std::cout << "  sections         ";
         for (const auto& [name, blob] : model.sections) std::cout << ' ' << name << " (" << blob.size() << " bytes)";
         std::cout << '\n';
+      }
+      if (!appearance.is_null()) {
+        // Per level: where the learned profiles are centred, which decides whether segment
+        // deforms the levels finer than the image (snake/segment.h).
+        std::cout << "  appearance        " << appearance["samples_per_profile"] << " samples per profile; centred on";
+        for (const auto& c : appearance["profiles_centred_on"]) std::cout << ' ' << c.get<std::string>();
+        std::cout << " (levels 0.." << appearance["levels"].get<int>() - 1 << ")\n";
       }
       if (!reference.is_null()) {
         const auto& sz = reference["size"];

@@ -165,6 +165,7 @@ Appearance build_appearance(const std::vector<Volume>& pyramid, const std::vecto
                                                  rounding_limits(pyramid[0], N, options.max_alignment_voxels));
       const RowMatrixX3d centres = levels[j] + shift.asDiagonal() * N;
       la.profiles = sample_profiles(sampler, centres, N, options.half_length, la.spacing_mm);
+      la.centred_on_edges = true;
       ++report.levels_aligned;
       report.mean_shift_mm += shift.sum();
       report.mean_abs_shift_mm += shift.cwiseAbs().sum();
@@ -196,7 +197,9 @@ void to_json(nlohmann::json& j, const ProfileAlignmentReport& r) {
 }
 
 namespace {
-constexpr char kMagic[8] = {'M', 'R', 'S', 'A', 'P', 'P', '0', '1'};
+constexpr char kMagic[8] = {'M', 'R', 'S', 'A', 'P', 'P', '0', '2'};
+// Version 01 differs only in having no centred_on_edges byte per level.
+constexpr char kMagicVersion01[8] = {'M', 'R', 'S', 'A', 'P', 'P', '0', '1'};
 
 template <class T>
 void put(std::vector<std::uint8_t>& b, const T& x) {
@@ -230,6 +233,7 @@ std::vector<std::uint8_t> serialize_appearance(const Appearance& a) {
   put<double>(b, a.shell_mm);
   for (const LevelAppearance& l : a.levels) {
     put<double>(b, l.spacing_mm);
+    put<std::uint8_t>(b, l.centred_on_edges ? 1 : 0);
     put<std::int32_t>(b, static_cast<std::int32_t>(l.profiles.rows()));
     put<std::int32_t>(b, static_cast<std::int32_t>(l.profiles.cols()));
     for (int r = 0; r < l.profiles.rows(); ++r)
@@ -239,7 +243,8 @@ std::vector<std::uint8_t> serialize_appearance(const Appearance& a) {
 }
 
 Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes) {
-  if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0)
+  const bool version01 = bytes.size() >= 8 && std::memcmp(bytes.data(), kMagicVersion01, 8) == 0;
+  if (bytes.size() < 8 || (!version01 && std::memcmp(bytes.data(), kMagic, 8) != 0))
     throw InputError("the model's appearance section is not in a format this build reads; rebuild the model");
   Reader r{bytes, 8};
   Appearance a;
@@ -259,6 +264,11 @@ Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes) {
   for (int j = 0; j < levels; ++j) {
     LevelAppearance l;
     l.spacing_mm = r.get<double>();
+    if (!version01) {
+      const auto centred = r.get<std::uint8_t>();
+      if (centred > 1) throw InputError("the model's appearance section is inconsistent; rebuild the model");
+      l.centred_on_edges = centred == 1;
+    }
     const int rows = r.get<std::int32_t>(), cols = r.get<std::int32_t>();
     if (rows < 0 || cols != 2 * a.half_length + 1 || !(l.spacing_mm > 0) ||
         static_cast<std::size_t>(rows) * cols * sizeof(float) > bytes.size() - r.pos)
@@ -313,9 +323,13 @@ void to_json(nlohmann::json& j, const Appearance& a) {
                      {"inside_spread", a.inside_spread},
                      {"outside_spread", a.outside_spread},
                      {"shell_mm", a.shell_mm}};
-  nlohmann::json spacing = nlohmann::json::array();
-  for (const auto& l : a.levels) spacing.push_back(l.spacing_mm);
+  nlohmann::json spacing = nlohmann::json::array(), centred_on = nlohmann::json::array();
+  for (const auto& l : a.levels) {
+    spacing.push_back(l.spacing_mm);
+    centred_on.push_back(l.centred_on_edges ? "edges" : "labels");
+  }
   j["profile_spacing_mm"] = spacing;
+  j["profiles_centred_on"] = centred_on;
 }
 
 }  // namespace mrsnake

@@ -20,6 +20,10 @@ namespace mrsnake {
 struct LevelAppearance {
   double spacing_mm = 1;      ///< distance between profile samples (the pyramid voxel size used)
   Eigen::MatrixXf profiles;   ///< n_j × K, sample k at offset (k − K/2)·spacing_mm along the normal
+  /// The profiles are centred on the image's edges (ProfileAlignment::edges), not on the
+  /// label's surface: then they locate the object's boundary below the label's rounding, and
+  /// the segmentation deforms this level even when it is finer than the image (segment.h).
+  bool centred_on_edges = false;
 };
 
 struct Appearance {
@@ -107,11 +111,15 @@ void to_json(nlohmann::json& j, const ProfileAlignmentReport& r);
 double profile_step_residual(const Appearance& appearance, const std::vector<RowMatrixX3i>& faces);
 
 /// Binary form (little-endian, versioned), for the model's optional "appearance" section.
+/// Version 02 adds each level's centred_on_edges.
 std::vector<std::uint8_t> serialize_appearance(const Appearance& appearance);
+/// Reads versions 01 (written before the alignment existed: every level centred on the
+/// labels) and 02.
 /// \throw InputError if the bytes are truncated, of another version or inconsistent.
 Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes);
 
-/// Summary for reports: levels, samples per profile, region statistics.
+/// Summary for reports: levels, samples per profile, region statistics, and per level the
+/// profile spacing and where the profiles are centred ("edges" or "labels").
 void to_json(nlohmann::json& j, const Appearance& a);
 
 }  // namespace mrsnake

@@ -818,6 +818,14 @@ TEST(Appearance, ProfilesCentredOnTheImagesEdgesUndoTheLabelsRounding) {
   EXPECT_TRUE(automatic.to_edges);  // a clean step
   EXPECT_LT(automatic.step_residual, AppearanceOptions{}.clean_edge_max_residual);
   EXPECT_EQ(chosen.levels[finest].profiles, on_edges.levels[finest].profiles);
+  // Each level records where its profiles sit: exactly the aligned ones on the edges.
+  int flagged = 0;
+  for (std::size_t j = 0; j < on_edges.levels.size(); ++j) {
+    flagged += on_edges.levels[j].centred_on_edges ? 1 : 0;
+    EXPECT_FALSE(on_labels.levels[j].centred_on_edges) << j;
+  }
+  EXPECT_EQ(flagged, edges.levels_aligned);
+  EXPECT_TRUE(on_edges.levels[finest].centred_on_edges);
   // The centre sample: the midpoint 0.5 on the edge, about 0.8 at the label's surface.
   EXPECT_NEAR(on_edges.levels[finest].profiles.col(half).mean(), 0.5, 0.06);
   EXPECT_GT(on_labels.levels[finest].profiles.col(half).mean(), 0.7);
@@ -858,12 +866,32 @@ TEST(Appearance, SerializationRoundTripsAndRejectsDamage) {
   a.levels[0].profiles = Eigen::MatrixXf::Random(12, 5);
   a.levels[1].spacing_mm = 1;
   a.levels[1].profiles = Eigen::MatrixXf::Random(42, 5);
+  a.levels[1].centred_on_edges = true;
   const auto bytes = serialize_appearance(a);
   const Appearance b = deserialize_appearance(bytes);
   EXPECT_EQ(b.half_length, 2);
   EXPECT_DOUBLE_EQ(b.region.inside, 0.8);
   ASSERT_EQ(b.levels.size(), 2u);
   EXPECT_EQ(b.levels[1].profiles, a.levels[1].profiles);
+  EXPECT_FALSE(b.levels[0].centred_on_edges);
+  EXPECT_TRUE(b.levels[1].centred_on_edges);
+  // Version 01 (models built before the flag): the same layout without the flag byte after
+  // each level's spacing; every level reads as centred on the labels.
+  {
+    const std::size_t header = 8 + 2 * 4 + 5 * 8, level0 = 8 + 1 + 2 * 4 + 12 * 5 * 4;
+    std::vector<std::uint8_t> old_bytes = bytes;
+    old_bytes.erase(old_bytes.begin() + static_cast<long>(header + level0 + 8));  // level 1's flag
+    old_bytes.erase(old_bytes.begin() + static_cast<long>(header + 8));           // level 0's flag
+    old_bytes[7] = '1';
+    const Appearance c = deserialize_appearance(old_bytes);
+    ASSERT_EQ(c.levels.size(), 2u);
+    EXPECT_EQ(c.levels[1].profiles, a.levels[1].profiles);
+    EXPECT_FALSE(c.levels[0].centred_on_edges);
+    EXPECT_FALSE(c.levels[1].centred_on_edges);
+  }
+  auto flag = bytes;
+  flag[8 + 2 * 4 + 5 * 8 + 8] = 2;  // level 0's flag: neither 0 nor 1
+  EXPECT_THROW(deserialize_appearance(flag), InputError);
   auto cut = bytes;
   cut.resize(cut.size() - 3);
   EXPECT_THROW(deserialize_appearance(cut), InputError);

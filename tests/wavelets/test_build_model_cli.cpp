@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 
 #include <nlohmann/json.hpp>
@@ -163,6 +165,25 @@ TEST(BuildModelCli, ProfileAlignmentIsChosenAndReported) {
   EXPECT_EQ(labels_kept["centred_on"], "labels");
   EXPECT_EQ(labels_kept["levels_aligned"].get<int>(), 0);
   EXPECT_EQ(labels_kept["step_residual"], automatic["step_residual"]);
+  // The model keeps, per level, where its profiles sit (segment deforms the levels finer than
+  // the image only when they sit on the edges), and model-info shows it.
+  const auto centred_on = [&](const std::string& name) {
+    const auto r = run_mrsnake("model-info --json " + (dir / name).string());
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    const nlohmann::json info = nlohmann::json::parse(r.output);
+    std::vector<std::string> where;
+    for (const auto& c : info["appearance"]["profiles_centred_on"]) where.push_back(c.get<std::string>());
+    return where;
+  };
+  const std::vector<std::string> aligned = centred_on("auto.model"), kept = centred_on("labels.model");
+  ASSERT_FALSE(aligned.empty());
+  EXPECT_EQ(std::count(aligned.begin(), aligned.end(), "edges"), automatic["levels_aligned"].get<int>());
+  EXPECT_EQ(aligned.back(), "edges");  // the finest level is sampled at full resolution
+  EXPECT_EQ(kept, std::vector<std::string>(aligned.size(), "labels"));
+  const auto text = run_mrsnake("model-info " + (dir / "auto.model").string());
+  EXPECT_NE(text.output.find("centred on labels"), std::string::npos) << text.output;
+  EXPECT_NE(text.output.find(" edges (levels 0.."), std::string::npos) << text.output;
+  std::filesystem::remove_all(dir);
 }
 
 TEST(BuildModelCli, CloseTunnelsMakesAGenusOneLabelModelable) {

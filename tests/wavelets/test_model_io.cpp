@@ -218,7 +218,11 @@ TEST(ModelIo, EveryDamageGetsASpecificError) {
 TEST(ModelInfoCli, PrintsTheManifestAndTheSynthesisError) {
   const fs::path root = scratch_dir("model-info-cli");
   const fs::path dir = root / "sphere.model";
-  save_model(dir.string(), sample_model());
+  // model-info decodes the appearance section (tests/wavelets/test_build_model_cli.cpp); the
+  // sample's bytes only stand in for one in the format tests.
+  ShapeModel model = sample_model();
+  model.sections.erase("appearance");
+  save_model(dir.string(), model);
   const auto text = run_mrsnake("model-info " + dir.string());
   EXPECT_EQ(text.exit_code, 0) << text.output;
   EXPECT_NE(text.output.find("format version 1"), std::string::npos) << text.output;
@@ -236,6 +240,12 @@ TEST(ModelInfoCli, PrintsTheManifestAndTheSynthesisError) {
   const auto bad = run_mrsnake("model-info " + dir.string());
   EXPECT_EQ(bad.exit_code, 3) << bad.output;
   EXPECT_NE(bad.output.find("truncated"), std::string::npos) << bad.output;
+  // A damaged appearance section is the model's defect, named as such.
+  const fs::path damaged = root / "damaged.model";
+  save_model(damaged.string(), sample_model());
+  const auto bad_appearance = run_mrsnake("model-info " + damaged.string());
+  EXPECT_EQ(bad_appearance.exit_code, 3) << bad_appearance.output;
+  EXPECT_NE(bad_appearance.output.find("appearance section"), std::string::npos) << bad_appearance.output;
   EXPECT_EQ(run_mrsnake("model-info " + (root / "absent.model").string()).exit_code, 3);
   EXPECT_EQ(run_mrsnake("model-info").exit_code, 2);
 }
