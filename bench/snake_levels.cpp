@@ -68,6 +68,7 @@ int main(int argc, char** argv) {
                                         {"profile_step", &o.profile_step_fraction},
                                         {"max_range_voxels", &o.max_range_voxels},
                                         {"min_edge_voxels", &o.min_edge_voxels},
+                                        {"fine_smoothing", &o.fine.offset_smoothing_voxels},
                                         {"distance_penalty", &o.profile_distance_penalty},
                                         {"edge_distance_penalty", &o.edge_distance_penalty},
                                         {"min_gain", &o.search_min_gain},
@@ -93,6 +94,10 @@ int main(int argc, char** argv) {
     else if (key == "reg_min_step") reg.min_step_mm = v;
     else if (key == "reg_step") reg.initial_step_mm = v;
     else if (key == "smoothing") o.snake.offset_smoothing = static_cast<int>(v);
+    else if (key == "fine_deform") o.fine.deform_edge_centred = v != 0;
+    else if (key == "fine_min_iterations") o.fine.min_iterations = static_cast<int>(v);
+    else if (key == "fine_patience") o.fine.patience = static_cast<int>(v);
+    else if (key == "fine_step") o.fine.profile_step_fraction = v;
     else if (key == "median") o.snake.offset_median = static_cast<int>(v);
     else if (key == "undo") o.undo_self_intersections = v != 0;
     else if (key == "max_iterations") o.snake.max_iterations = static_cast<int>(v);

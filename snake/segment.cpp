@@ -194,8 +194,18 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     edges[j] = mean_edge_length(model.levels[j], model.faces(j));
     pyr[j] = pyramid_level_for_edge(edges[j], spacings, options.edge_per_voxel);
   }
-  const auto search_for = [&](int j, double range_mm, RegionStats stats,
-                              const VertexRings* rings) -> std::pair<ExternalSearch, double> {
+  // With profiles, a level finer than the image (mean edge below min_edge_voxels) is only
+  // synthesized when its profiles sit on the labels: they then sample the same voxels as its
+  // parent's, and on the real images its snake lost Dice. Profiles centred on the image's
+  // edges deform it, with their noise averaged over rings (FineLevelOptions).
+  // (The step-edge force fits sub-voxel steps; on synthetic volumes those levels help.)
+  const auto finer_than_image = [&](int j) { return use_profiles && edges[j] < options.min_edge_voxels * spacings[0]; };
+  const auto deformed_finer_than_image = [&](int j) {
+    return finer_than_image(j) && options.fine.deform_edge_centred && model.appearance->levels[j].centred_on_edges;
+  };
+  // fine: level j is deformed although finer than the image (FineLevelOptions).
+  const auto search_for = [&](int j, double range_mm, RegionStats stats, const VertexRings* rings,
+                              bool fine) -> std::pair<ExternalSearch, double> {
     const int p = pyr[j];
     const VolumeSampler* sampler = &samplers[p];
     NormalSearchOptions so;
@@ -206,7 +216,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     so.ring_full_weight_cost = options.cost_ring_full_weight_cost;
     if (use_profiles) {
       const LevelAppearance* la = &model.appearance->levels[j];
-      so.step_mm = options.profile_step_fraction * la->spacing_mm;
+      so.step_mm = (fine ? options.fine.profile_step_fraction : options.profile_step_fraction) * la->spacing_mm;
       so.max_cost = options.max_profile_cost;
       so.distance_penalty = options.profile_distance_penalty;
       return {[sampler, la, so](const RowMatrixX3d& V, const RowMatrixX3d& N) {
@@ -332,7 +342,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     const int jf = std::min(L, options.fit_level);
     // (One similarity moves the whole mesh here: every vertex keeps its own evidence.)
     const double fit_range = range_for(jf, options.coarse_range_edge_fraction, options.fit_min_range_voxels);
-    const auto [search, step] = search_for(jf, fit_range, stats, nullptr);
+    const auto [search, step] = search_for(jf, fit_range, stats, nullptr, false);
     (void)step;
     double best_cost = std::numeric_limits<double>::infinity();
     for (const auto& [start, start_name] : starts) {
@@ -369,8 +379,18 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
       synthesis_seconds = seconds_since(t_syn);
     }
     const double range = range_for(j, options.range_edge_fraction, options.min_range_voxels);
-    const DeformableSurface snake(model.faces(j), model.levels[j], options.snake);
-    const auto [search, step] = search_for(j, range, stats, &snake.rings());
+    const bool fine = deformed_finer_than_image(j);
+    const bool deform = fine || !finer_than_image(j);
+    SnakeOptions level_options = options.snake;
+    if (fine) {
+      const double sigma_in_edges = options.fine.offset_smoothing_voxels * spacings[0] / edges[j];
+      const double passes = sigma_in_edges * sigma_in_edges / (3.0 / 7.0);
+      level_options.offset_smoothing = std::max(level_options.offset_smoothing, static_cast<int>(std::lround(passes)));
+      level_options.min_iterations = std::min(level_options.min_iterations, options.fine.min_iterations);
+      level_options.patience = std::min(level_options.patience, options.fine.patience);
+    }
+    const DeformableSurface snake(model.faces(j), model.levels[j], level_options);
+    const auto [search, step] = search_for(j, range, stats, &snake.rings(), fine);
     LevelOutcome out;
     out.level = j;
     out.pyramid_level = pyr[j];
@@ -379,15 +399,11 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     out.vertices = static_cast<int>(V.rows());
     out.synthesis_seconds = synthesis_seconds;
     const RowMatrixX3d V_level_start = V;
-    // With profiles, a level finer than the image (mean edge below min_edge_voxels) is only
-    // synthesized: its profiles sample the same voxels as its parent's, and on the real images
-    // its snake lost Dice.
-    // (The step-edge force fits sub-voxel steps; on synthetic volumes those levels help.)
-    const bool finer_than_image = use_profiles && edges[j] < options.min_edge_voxels * spacings[0];
     SnakeLevelReport skipped;
     skipped.converged = true;
-    out.snake = finer_than_image ? skipped : snake.run(V, search, step, range);
-    out.deformed = !finer_than_image;
+    out.snake = deform ? snake.run(V, search, step, range) : skipped;
+    out.deformed = deform;
+    out.offset_smoothing = deform ? level_options.offset_smoothing : 0;
     // The fold test inside the run is local; a surface can still pass through itself.
     // (A level only synthesized has not moved from its start: nothing to undo.)
     if (options.undo_self_intersections && out.deformed)
@@ -487,6 +503,7 @@ nlohmann::json segment_report(const SegmentResult& r) {
                       {"rejected_steps", l.snake.rejected_steps},
                       {"rolled_back_vertices", l.rolled_back_vertices},
                       {"deformed", l.deformed},
+                      {"offset_smoothing", l.offset_smoothing},
                       {"flipped_faces", l.snake.flipped_faces}});
   }
   j["levels"] = levels;

@@ -23,6 +23,7 @@
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include "snake/appearance.h"
 #include "snake/image_pyramid.h"
 #include "snake/rasterize.h"
 #include "snake/segment.h"
@@ -183,6 +184,47 @@ TEST(SegmentE2E, Heart) {
   EXPECT_GE(c.final.dice, 0.95);
   EXPECT_LE(c.final.assd_mm, 0.5);
   EXPECT_EQ(c.self_intersections, 0);
+}
+
+TEST(SegmentE2E, HeartLevelsFinerThanTheImageAreDeformedOnlyWithEdgeCentredProfiles) {
+  // The heart's learned profiles are close enough to a step that build-model centres the
+  // finest levels' profiles on the image's edges; segment then deforms the levels finer than
+  // min_edge_voxels too, with their offsets averaged over rings. The same model with its
+  // profiles marked as sitting on the labels only synthesizes those levels.
+  const SynthResult target = make_instance(SynthShape::heart, 41, 4.0, 64);
+  const SynthResult ref = make_instance(SynthShape::heart, 42, 4.0, 64);
+  const SnakeModel centred = build_test_model(ref, 4, nullptr);
+  ASSERT_TRUE(centred.appearance.has_value());
+  SnakeModel on_labels = centred;
+  for (LevelAppearance& l : on_labels.appearance->levels) l.centred_on_edges = false;
+  const SegmentOptions options = profile_force();
+  const double voxel = 1.0;  // make_instance's grid
+  std::vector<int> fine_levels;
+  for (int j = 0; j <= centred.finest_level(); ++j)
+    if (mean_edge_length(centred.levels[j], centred.faces(j)) < options.min_edge_voxels * voxel) fine_levels.push_back(j);
+  ASSERT_FALSE(fine_levels.empty()) << "the test needs a level finer than the image";
+  const SegmentResult with = segment(target.image, centred, options), without = segment(target.image, on_labels, options);
+  for (const int j : fine_levels) {
+    ASSERT_TRUE(centred.appearance->levels[j].centred_on_edges) << j;
+    EXPECT_TRUE(with.levels[j].deformed) << j;
+    EXPECT_GE(with.levels[j].snake.iterations, 1) << j;
+    // σ = 1.85 voxels of averaging: k passes with k·(3/7)·edge² = σ².
+    const double edge = mean_edge_length(centred.levels[j], centred.faces(j));
+    const double sigma = options.fine.offset_smoothing_voxels * voxel;
+    EXPECT_EQ(with.levels[j].offset_smoothing, static_cast<int>(std::lround(sigma * sigma / (3.0 / 7.0 * edge * edge))));
+    EXPECT_GT(with.levels[j].offset_smoothing, options.snake.offset_smoothing) << j;
+    EXPECT_FALSE(without.levels[j].deformed) << j;
+    EXPECT_EQ(without.levels[j].snake.iterations, 0) << j;
+  }
+  for (int j = 0; j < fine_levels.front(); ++j) {
+    EXPECT_TRUE(without.levels[j].deformed) << j;
+    EXPECT_EQ(with.levels[j].offset_smoothing, options.snake.offset_smoothing) << j;
+  }
+  EXPECT_EQ(with.self_intersections, 0);
+  const double dice_with = evaluate_segmentation(rasterize_mesh(with.surface, target.truth), target.truth).dice;
+  const double dice_without = evaluate_segmentation(rasterize_mesh(without.surface, target.truth), target.truth).dice;
+  std::printf("finest levels deformed: Dice %.4f; only synthesized: %.4f\n", dice_with, dice_without);
+  EXPECT_GT(dice_with, dice_without);
 }
 
 TEST(SegmentCommand, WritesEveryOutputOnTheImageGridWithScores) {
