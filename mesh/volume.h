@@ -2,6 +2,7 @@
 /// \file volume.h
 /// A plain 3D image that crosses the line between ITK translation units and the rest
 /// (ITK bundles its own Eigen, so no Eigen or ITK type may appear here).
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <vector>
@@ -19,6 +20,8 @@ struct Volume {
   std::vector<float> data;
 
   std::size_t num_voxels() const { return size[0] * size[1] * size[2]; }
+  /// The largest voxel side, in mm.
+  double max_spacing() const { return std::max({spacing[0], spacing[1], spacing[2]}); }
   std::size_t index(std::size_t i, std::size_t j, std::size_t k) const {
     return i + size[0] * (j + size[1] * k);
   }

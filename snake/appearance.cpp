@@ -35,7 +35,6 @@ double mean_edge_length(const RowMatrixX3d& V, const RowMatrixX3i& F) {
 }
 
 namespace {
-double max_spacing(const Volume& v) { return std::max({v.spacing[0], v.spacing[1], v.spacing[2]}); }
 
 void median_and_spread(std::vector<float>& a, double& median, double& spread) {
   if (a.empty()) {
@@ -114,7 +113,7 @@ Appearance build_appearance(const std::vector<Volume>& pyramid, const std::vecto
   Appearance a;
   a.half_length = options.half_length;
   std::vector<double> spacings;
-  for (const Volume& v : pyramid) spacings.push_back(max_spacing(v));
+  for (const Volume& v : pyramid) spacings.push_back(v.max_spacing());
   RowMatrixX3d N;
   std::vector<int> pyramid_levels;
   for (std::size_t j = 0; j < levels.size(); ++j) {
@@ -131,8 +130,8 @@ Appearance build_appearance(const std::vector<Volume>& pyramid, const std::vecto
   const VolumeSampler sampler(pyramid[0]);
   const RowMatrixX3d& V = levels.back();
   vertex_normals(V, faces.back(), N);
-  const double h = 0.5 * max_spacing(pyramid[0]);
-  a.shell_mm = options.shell_voxels * max_spacing(pyramid[0]);
+  const double h = 0.5 * pyramid[0].max_spacing();
+  a.shell_mm = options.shell_voxels * pyramid[0].max_spacing();
   const int steps = std::max(1, static_cast<int>(std::floor(a.shell_mm / h)));
   std::vector<float> in, out;
   for (int v = 0; v < V.rows(); ++v) {

@@ -67,7 +67,7 @@ void require_same_grid(const Volume& a, const Volume& b, const std::string& a_na
   const std::string intro = a_name + " and " + b_name + " are on different grids: ";
   const std::string fix = "; resample " + a_name + " onto the grid of " + b_name;
   if (a.size != b.size) throw InputError(intro + "sizes " + triple(a.size) + " and " + triple(b.size) + fix);
-  const double scale = std::max({a.spacing[0], a.spacing[1], a.spacing[2]});
+  const double scale = a.max_spacing();
   for (int d = 0; d < 3; ++d)
     if (std::abs(a.spacing[d] - b.spacing[d]) > 1e-5 * scale)
       throw InputError(intro + "spacings " + triple(a.spacing) + " and " + triple(b.spacing) + " mm" + fix);

@@ -271,8 +271,8 @@ ReferenceRegistration register_reference(const Volume& reference, const std::vec
   const auto t0 = std::chrono::steady_clock::now();
   ReferenceRegistration out;
   std::vector<double> spacings;
-  for (const Volume* v : pyramid) spacings.push_back(std::max({v->spacing[0], v->spacing[1], v->spacing[2]}));
-  const double ref_spacing = std::max({reference.spacing[0], reference.spacing[1], reference.spacing[2]});
+  for (const Volume* v : pyramid) spacings.push_back(v->max_spacing());
+  const double ref_spacing = reference.max_spacing();
   out.pyramid_level = pyramid_level_for_edge(ref_spacing, spacings, 1.0);
   RegistrationOptions ro = options.itk;
   for (int a = 0; a < 3; ++a) ro.initial_translation[a] = start_translation[a];

@@ -180,7 +180,7 @@ double edge_radius(const Volume& v, const std::array<double, 3>& centre) {
                           (p[2] - centre[2]) * (p[2] - centre[2]);
         samples.emplace_back(gx * gx + gy * gy + gz * gz, r2);
       }
-  const double min_radius = 2.0 * std::max({v.spacing[0], v.spacing[1], v.spacing[2]});
+  const double min_radius = 2.0 * v.max_spacing();
   if (samples.empty()) return min_radius;
   const std::size_t top = std::max<std::size_t>(1, samples.size() / 10);
   std::nth_element(samples.begin(), samples.begin() + static_cast<long>(top), samples.end(),

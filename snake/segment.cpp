@@ -15,7 +15,6 @@ namespace mrsnake {
 namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-double max_spacing(const Volume& v) { return std::max({v.spacing[0], v.spacing[1], v.spacing[2]}); }
 
 // Frame of the parent edge (a, b) from the coarse positions and vertex normals.
 Eigen::Matrix3d edge_frame(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& na,
@@ -180,7 +179,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   }
   const bool level0_raw = pyramid[0] == &image;
   std::vector<double> spacings;
-  for (const Volume* v : pyramid) spacings.push_back(max_spacing(*v));
+  for (const Volume* v : pyramid) spacings.push_back(v->max_spacing());
   std::vector<VolumeSampler> samplers;
   samplers.reserve(pyramid.size());
   for (std::size_t k = 0; k < pyramid.size(); ++k)
@@ -276,7 +275,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
         have_shift = true;
       } catch (const AlgorithmError&) {  // nothing to align to: no second start
       }
-      if (have_shift && shift.norm() > 0.5 * max_spacing(*model.reference_image)) {
+      if (have_shift && shift.norm() > 0.5 * model.reference_image->max_spacing()) {
         const double first_seconds = result.registration->seconds;
         const std::string first_rejection = result.registration->rejection;
         result.registration = register_reference(*model.reference_image, pyramid, s0, o0, options.registration, shift);
