@@ -47,8 +47,15 @@ void add_model_info_command(CLI::App& app) {
     if (const auto it = model.sections.find(kReferenceImageSection); it != model.sections.end())
       reference_image_to_json(reference, deserialize_reference_image(it->second));
     nlohmann::json appearance = nullptr;
-    if (const auto it = model.sections.find(kAppearanceSection); it != model.sections.end())
-      appearance = deserialize_appearance(it->second);
+    if (const auto it = model.sections.find(kAppearanceSection); it != model.sections.end()) {
+      const Appearance decoded = deserialize_appearance(it->second);
+      // The same check as segment's: one profile per vertex of every level.
+      bool fits = static_cast<int>(decoded.levels.size()) == model.levels() + 1;
+      for (std::size_t j = 0; fits && j < decoded.levels.size(); ++j)
+        fits = decoded.levels[j].profiles.rows() == model.level_positions[j].rows();
+      if (!fits) throw InputError("the model's appearance does not match its levels; rebuild the model");
+      appearance = decoded;
+    }
     nlohmann::json synthesis = {{"level", model.levels()},
                                 {"max_error_mm", max_err},
                                 {"rms_error_mm", rms_err},

@@ -164,7 +164,7 @@ Appearance build_appearance(const std::vector<Volume>& pyramid, const std::vecto
                                                  rounding_limits(pyramid[0], N, options.max_alignment_voxels));
       const RowMatrixX3d centres = levels[j] + shift.asDiagonal() * N;
       la.profiles = sample_profiles(sampler, centres, N, options.half_length, la.spacing_mm);
-      la.centred_on_edges = true;
+      la.centre = ProfileCentre::edges;
       ++report.levels_aligned;
       report.mean_shift_mm += shift.sum();
       report.mean_abs_shift_mm += shift.cwiseAbs().sum();
@@ -177,6 +177,15 @@ Appearance build_appearance(const std::vector<Volume>& pyramid, const std::vecto
   }
   if (alignment) *alignment = report;
   return a;
+}
+
+std::string to_string(ProfileCentre centre) {
+  switch (centre) {
+    case ProfileCentre::labels: return "labels";
+    case ProfileCentre::edges: return "edges";
+    case ProfileCentre::unrecorded: break;
+  }
+  return "unrecorded";
 }
 
 ProfileAlignment parse_profile_alignment(const std::string& name) {
@@ -197,7 +206,7 @@ void to_json(nlohmann::json& j, const ProfileAlignmentReport& r) {
 
 namespace {
 constexpr char kMagic[8] = {'M', 'R', 'S', 'A', 'P', 'P', '0', '2'};
-// Version 01 differs only in having no centred_on_edges byte per level.
+// Version 01 differs only in having no centre byte per level.
 constexpr char kMagicVersion01[8] = {'M', 'R', 'S', 'A', 'P', 'P', '0', '1'};
 
 template <class T>
@@ -232,7 +241,7 @@ std::vector<std::uint8_t> serialize_appearance(const Appearance& a) {
   put<double>(b, a.shell_mm);
   for (const LevelAppearance& l : a.levels) {
     put<double>(b, l.spacing_mm);
-    put<std::uint8_t>(b, l.centred_on_edges ? 1 : 0);
+    put<std::uint8_t>(b, l.centre == ProfileCentre::edges ? 1 : 0);
     put<std::int32_t>(b, static_cast<std::int32_t>(l.profiles.rows()));
     put<std::int32_t>(b, static_cast<std::int32_t>(l.profiles.cols()));
     for (int r = 0; r < l.profiles.rows(); ++r)
@@ -263,10 +272,12 @@ Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes) {
   for (int j = 0; j < levels; ++j) {
     LevelAppearance l;
     l.spacing_mm = r.get<double>();
-    if (!version01) {
+    if (version01) {
+      l.centre = ProfileCentre::unrecorded;
+    } else {
       const auto centred = r.get<std::uint8_t>();
       if (centred > 1) throw InputError("the model's appearance section is inconsistent; rebuild the model");
-      l.centred_on_edges = centred == 1;
+      l.centre = centred == 1 ? ProfileCentre::edges : ProfileCentre::labels;
     }
     const int rows = r.get<std::int32_t>(), cols = r.get<std::int32_t>();
     if (rows < 0 || cols != 2 * a.half_length + 1 || !(l.spacing_mm > 0) ||
@@ -325,7 +336,7 @@ void to_json(nlohmann::json& j, const Appearance& a) {
   nlohmann::json spacing = nlohmann::json::array(), centred_on = nlohmann::json::array();
   for (const auto& l : a.levels) {
     spacing.push_back(l.spacing_mm);
-    centred_on.push_back(l.centred_on_edges ? "edges" : "labels");
+    centred_on.push_back(to_string(l.centre));
   }
   j["profile_spacing_mm"] = spacing;
   j["profiles_centred_on"] = centred_on;

@@ -16,14 +16,25 @@
 
 namespace mrsnake {
 
+/// Where a level's learned profiles are centred along the normals.
+enum class ProfileCentre {
+  labels,      ///< on the label's surface
+  /// On the image's edges (ProfileAlignment::edges): then they locate the object's boundary
+  /// below the label's rounding, and the segmentation deforms the level even when it is finer
+  /// than the image (segment.h).
+  edges,
+  /// Not recorded (appearance format 01: session 10's build-model already centred some
+  /// profiles on the edges without saying so); treated as labels.
+  unrecorded,
+};
+/// "labels", "edges" or "unrecorded".
+std::string to_string(ProfileCentre centre);
+
 /// The profiles of one level of the hierarchy.
 struct LevelAppearance {
   double spacing_mm = 1;      ///< distance between profile samples (the pyramid voxel size used)
   Eigen::MatrixXf profiles;   ///< n_j × K, sample k at offset (k − K/2)·spacing_mm along the normal
-  /// The profiles are centred on the image's edges (ProfileAlignment::edges), not on the
-  /// label's surface: then they locate the object's boundary below the label's rounding, and
-  /// the segmentation deforms this level even when it is finer than the image (segment.h).
-  bool centred_on_edges = false;
+  ProfileCentre centre = ProfileCentre::labels;
 };
 
 struct Appearance {
@@ -111,15 +122,14 @@ void to_json(nlohmann::json& j, const ProfileAlignmentReport& r);
 double profile_step_residual(const Appearance& appearance, const std::vector<RowMatrixX3i>& faces);
 
 /// Binary form (little-endian, versioned), for the model's optional "appearance" section.
-/// Version 02 adds each level's centred_on_edges.
+/// Version 02 adds each level's centre (labels or edges).
 std::vector<std::uint8_t> serialize_appearance(const Appearance& appearance);
-/// Reads versions 01 (written before the alignment existed: every level centred on the
-/// labels) and 02.
+/// Reads versions 01 (every level's centre ProfileCentre::unrecorded) and 02.
 /// \throw InputError if the bytes are truncated, of another version or inconsistent.
 Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes);
 
 /// Summary for reports: levels, samples per profile, region statistics, and per level the
-/// profile spacing and where the profiles are centred ("edges" or "labels").
+/// profile spacing and where the profiles are centred ("edges", "labels", or "unrecorded").
 void to_json(nlohmann::json& j, const Appearance& a);
 
 }  // namespace mrsnake

@@ -115,6 +115,18 @@ std::string to_string(ForceMode mode) {
   return "?";
 }
 
+SnakeOptions fine_level_snake_options(const SegmentOptions& options, double edge_voxels) {
+  SnakeOptions o = options.snake;
+  // k passes of the 7-point average on a regular mesh of edge e: a variance of k·(3/7)·e².
+  const double sigma_in_edges = options.fine.offset_smoothing_voxels / edge_voxels;
+  const double passes = sigma_in_edges * sigma_in_edges / (3.0 / 7.0);
+  if (std::isfinite(passes))
+    o.offset_smoothing = std::max(o.offset_smoothing, static_cast<int>(std::lround(std::min(passes, 1000.0))));
+  o.min_iterations = std::min(o.min_iterations, options.fine.min_iterations);
+  o.patience = std::min(o.patience, options.fine.patience);
+  return o;
+}
+
 SegmentResult segment(const Volume& image, const SnakeModel& model, const SegmentOptions& options,
                       const ProgressFn& progress) {
   const auto t_start = Clock::now();
@@ -199,12 +211,16 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   // edges deform it, with their noise averaged over rings (FineLevelOptions).
   // (The step-edge force fits sub-voxel steps; on synthetic volumes those levels help.)
   const auto finer_than_image = [&](int j) { return use_profiles && edges[j] < options.min_edge_voxels * spacings[0]; };
-  const auto deformed_finer_than_image = [&](int j) {
-    return finer_than_image(j) && options.fine.deform_edge_centred && model.appearance->levels[j].centred_on_edges;
+  const auto deform_although_finer = [&](int j) {
+    // (Not far below the voxel either: the flag was set on the reference image's grid, and on
+    // a coarser image the profiles no longer resolve the level.)
+    return finer_than_image(j) && options.fine.deform_edge_centred &&
+           model.appearance->levels[j].centre == ProfileCentre::edges &&
+           edges[j] >= options.fine.min_edge_voxels * spacings[0];
   };
-  // fine: level j is deformed although finer than the image (FineLevelOptions).
+  // profile_step_fraction: of the profile spacing, for the profile search.
   const auto search_for = [&](int j, double range_mm, RegionStats stats, const VertexRings* rings,
-                              bool fine) -> std::pair<ExternalSearch, double> {
+                              double profile_step_fraction) -> std::pair<ExternalSearch, double> {
     const int p = pyr[j];
     const VolumeSampler* sampler = &samplers[p];
     NormalSearchOptions so;
@@ -215,7 +231,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     so.ring_full_weight_cost = options.cost_ring_full_weight_cost;
     if (use_profiles) {
       const LevelAppearance* la = &model.appearance->levels[j];
-      so.step_mm = (fine ? options.fine.profile_step_fraction : options.profile_step_fraction) * la->spacing_mm;
+      so.step_mm = profile_step_fraction * la->spacing_mm;
       so.max_cost = options.max_profile_cost;
       so.distance_penalty = options.profile_distance_penalty;
       return {[sampler, la, so](const RowMatrixX3d& V, const RowMatrixX3d& N) {
@@ -341,7 +357,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     const int jf = std::min(L, options.fit_level);
     // (One similarity moves the whole mesh here: every vertex keeps its own evidence.)
     const double fit_range = range_for(jf, options.coarse_range_edge_fraction, options.fit_min_range_voxels);
-    const auto [search, step] = search_for(jf, fit_range, stats, nullptr, false);
+    const auto [search, step] = search_for(jf, fit_range, stats, nullptr, options.profile_step_fraction);
     (void)step;
     double best_cost = std::numeric_limits<double>::infinity();
     for (const auto& [start, start_name] : starts) {
@@ -378,18 +394,12 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
       synthesis_seconds = seconds_since(t_syn);
     }
     const double range = range_for(j, options.range_edge_fraction, options.min_range_voxels);
-    const bool fine = deformed_finer_than_image(j);
+    const bool fine = deform_although_finer(j);
     const bool deform = fine || !finer_than_image(j);
-    SnakeOptions level_options = options.snake;
-    if (fine) {
-      const double sigma_in_edges = options.fine.offset_smoothing_voxels * spacings[0] / edges[j];
-      const double passes = sigma_in_edges * sigma_in_edges / (3.0 / 7.0);
-      level_options.offset_smoothing = std::max(level_options.offset_smoothing, static_cast<int>(std::lround(passes)));
-      level_options.min_iterations = std::min(level_options.min_iterations, options.fine.min_iterations);
-      level_options.patience = std::min(level_options.patience, options.fine.patience);
-    }
+    const SnakeOptions level_options = fine ? fine_level_snake_options(options, edges[j] / spacings[0]) : options.snake;
     const DeformableSurface snake(model.faces(j), model.levels[j], level_options);
-    const auto [search, step] = search_for(j, range, stats, &snake.rings(), fine);
+    const auto [search, step] = search_for(j, range, stats, &snake.rings(),
+                                           fine ? options.fine.profile_step_fraction : options.profile_step_fraction);
     LevelOutcome out;
     out.level = j;
     out.pyramid_level = pyr[j];

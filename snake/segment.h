@@ -66,18 +66,26 @@ std::string to_string(ForceMode mode);
 /// How a level finer than the image is deformed (SegmentOptions::fine).
 struct FineLevelOptions {
   bool deform_edge_centred = true;  ///< false: only synthesize every level finer than min_edge_voxels
+  /// Levels whose mean edge is below this many voxels of the image are never deformed: the
+  /// profiles' centring was decided on the reference image's grid, and on a coarser image
+  /// they no longer resolve such a level.
+  double min_edge_voxels = 0.5;
   /// Standard deviation, in voxels of the full-resolution image, of the ring averaging of the
   /// matched offsets: k passes of the 7-point average on a regular mesh of edge e spread a
   /// value with a variance of k·(3/7)·e² per axis. On the five synthetic heart 128³ cases
   /// (finest edges 1.0 voxel), 1.3 / 1.6 / 1.85 / 2.3 / 2.9 voxels gave a mean Dice of
-  /// 0.99084 / 0.9910 / 0.99106 / 0.99108 / 0.99104, and at SNR 2 0.9860 to 0.9880: flat
-  /// from 1.6 on, so the smallest averaging there.
+  /// 0.99084 / 0.9910 / 0.99106 / 0.99108 / 0.99104: 1.85 is the knee of the mean. At SNR 2
+  /// alone the Dice kept rising, 0.9860 to 0.9880.
   double offset_smoothing_voxels = 1.85;
+  /// The level starts within a voxel: it may stop after min_iterations (at most
+  /// SnakeOptions::min_iterations), once the offsets and the energy have settled over
+  /// patience iterations (at most SnakeOptions::patience).
   int min_iterations = 2;
   int patience = 2;
   /// Profile search step, as a fraction of the profile spacing (SegmentOptions has 0.5):
   /// after the averaging, the half steps changed the five synthetic hearts' mean Dice by 0.0001
-  /// and took twice the time.
+  /// and took twice the time. (The snake's settling tolerance is relative to this step, so it
+  /// is twice as loose too.)
   double profile_step_fraction = 1.0;
 };
 
@@ -134,14 +142,14 @@ struct SegmentOptions {
   /// level's start (deformable_surface.h).
   bool undo_self_intersections = true;
   /// With the profile force, levels whose mean edge (on the model) is below this many voxels
-  /// of the image are only synthesized, not deformed, unless their profiles are centred on
-  /// the image's edges (fine, below) (0: deform every level). On the real
+  /// of the image are only synthesized, not deformed (0: deform every level), unless their
+  /// profiles are centred on the image's edges (`fine`, below). On the real
   /// images their snake lost Dice (e.g. the CT liver's finest level). 1.25, not 1: the synthetic
   /// heart models' finest edges are 0.998-1.000 voxel, so at 1 a 0.2 % change in the model
   /// (the remesher's surface fit) decided whether that level ran: 70 ms more and Dice -0.001.
   double min_edge_voxels = 1.25;
   /// Levels finer than min_edge_voxels whose profiles are centred on the image's edges
-  /// (LevelAppearance::centred_on_edges) are deformed after all: such profiles locate the
+  /// (LevelAppearance::centre) are deformed after all: such profiles locate the
   /// object's boundary below the label's rounding. Each matched offset is close to the
   /// voxel's noise there, so the offsets are averaged over rings until the averaging reaches
   /// fine.offset_smoothing_voxels, and the level starts within a voxel, so it may stop sooner.
@@ -158,7 +166,7 @@ struct LevelOutcome {
   int vertices = 0;
   SnakeLevelReport snake;
   int rolled_back_vertices = 0;  ///< vertices moved back to undo self-intersections
-  bool deformed = true;          ///< false: finer than the image (min_edge_voxels) with profiles on the labels, only synthesized
+  bool deformed = true;          ///< false: finer than the image (min_edge_voxels) and not deformed as such (FineLevelOptions), only synthesized
   int offset_smoothing = 0;      ///< ring-averaging passes over the matched offsets (SnakeOptions)
   double seconds = 0;          ///< synthesis + snake of this level
   double synthesis_seconds = 0;
@@ -185,6 +193,14 @@ struct SegmentResult {
   std::vector<std::pair<std::string, double>> stage_seconds;
   double compute_seconds = 0;  ///< everything after loading, without the final self-intersection count
 };
+
+/// The snake options of a level deformed although finer than the image (FineLevelOptions):
+/// options.snake with the offsets averaged over rings until their spread reaches
+/// fine.offset_smoothing_voxels (edge_voxels: the level's mean edge in voxels of the image),
+/// and the fine level's iteration limits.
+/// \pre edge_voxels > 0 (otherwise the averaging is left as in options.snake).
+/// \throw nothing.
+SnakeOptions fine_level_snake_options(const SegmentOptions& options, double edge_voxels);
 
 /// Segments `image` (any spacing and direction; not modified) with the model.
 /// \throw InputError if the model has no levels or its appearance does not match it, or if

@@ -134,8 +134,8 @@ std::string segment_report_html(const SegmentPageInput& in) {
     for (const SnakeConvergence& c : in.convergence) {
       if (!c.deformed) {
         page.note("Level " + std::to_string(c.level) +
-                  " was not deformed: its edges are finer than the image allows (min_edge_voxels), so it is the "
-                  "wavelet synthesis of the level before.");
+                  " was not deformed: its edges are finer than the image allows (min_edge_voxels) and its profiles "
+                  "are not centred on the image's edges, so it is the wavelet synthesis of the level before.");
         continue;
       }
       picture(page, "The convergence plot of level " + std::to_string(c.level), [&] {
@@ -165,7 +165,7 @@ std::string segment_report_html(const SegmentPageInput& in) {
         {"level", "level"}, {"vertices", "vertices"}, {"pyramid_level", "pyramid level"}, {"voxel_mm", "voxel (mm)"},
         {"search_range_mm", "search range (mm)"}, {"iterations", "iterations"}, {"converged", "converged"},
         {"energy", "energy"}, {"mean_abs_offset_mm", "mean |offset| (mm)"}, {"rejected_steps", "rejected steps"},
-        {"rolled_back_vertices", "rolled back"}, {"deformed", "deformed"},
+        {"rolled_back_vertices", "rolled back"}, {"deformed", "deformed"}, {"offset_smoothing", "offset averaging passes"},
         {"flipped_faces", "flipped faces"}, {"synthesis_seconds", "synthesis (s)"}, {"seconds", "seconds"}};
     std::vector<std::string> header;
     for (const auto& c : columns) header.push_back(c.second);

@@ -195,30 +195,43 @@ TEST(SegmentE2E, HeartLevelsFinerThanTheImageAreDeformedOnlyWithEdgeCentredProfi
   const SynthResult ref = make_instance(SynthShape::heart, 42, 4.0, 64);
   const SnakeModel centred = build_test_model(ref, 4, nullptr);
   ASSERT_TRUE(centred.appearance.has_value());
-  SnakeModel on_labels = centred;
-  for (LevelAppearance& l : on_labels.appearance->levels) l.centred_on_edges = false;
+  SnakeModel on_labels = centred, unrecorded = centred;
+  for (LevelAppearance& l : on_labels.appearance->levels) l.centre = ProfileCentre::labels;
+  for (LevelAppearance& l : unrecorded.appearance->levels) l.centre = ProfileCentre::unrecorded;  // an old model
   const SegmentOptions options = profile_force();
-  const double voxel = 1.0;  // make_instance's grid
+  SegmentOptions switched_off = options;
+  switched_off.fine.deform_edge_centred = false;
+  const double voxel = target.image.max_spacing();
   std::vector<int> fine_levels;
   for (int j = 0; j <= centred.finest_level(); ++j)
     if (mean_edge_length(centred.levels[j], centred.faces(j)) < options.min_edge_voxels * voxel) fine_levels.push_back(j);
   ASSERT_FALSE(fine_levels.empty()) << "the test needs a level finer than the image";
   const SegmentResult with = segment(target.image, centred, options), without = segment(target.image, on_labels, options);
+  const std::vector<SegmentResult> synthesized_only = {without, segment(target.image, unrecorded, options),
+                                                       segment(target.image, centred, switched_off)};
   for (const int j : fine_levels) {
-    ASSERT_TRUE(centred.appearance->levels[j].centred_on_edges) << j;
+    ASSERT_EQ(centred.appearance->levels[j].centre, ProfileCentre::edges) << j;
     EXPECT_TRUE(with.levels[j].deformed) << j;
     EXPECT_GE(with.levels[j].snake.iterations, 1) << j;
     // σ = 1.85 voxels of averaging: k passes with k·(3/7)·edge² = σ².
     const double edge = mean_edge_length(centred.levels[j], centred.faces(j));
     const double sigma = options.fine.offset_smoothing_voxels * voxel;
     EXPECT_EQ(with.levels[j].offset_smoothing, static_cast<int>(std::lround(sigma * sigma / (3.0 / 7.0 * edge * edge))));
+    EXPECT_EQ(with.levels[j].offset_smoothing, fine_level_snake_options(options, edge / voxel).offset_smoothing);
     EXPECT_GT(with.levels[j].offset_smoothing, options.snake.offset_smoothing) << j;
-    EXPECT_FALSE(without.levels[j].deformed) << j;
-    EXPECT_EQ(without.levels[j].snake.iterations, 0) << j;
+    for (const SegmentResult& r : synthesized_only) {
+      EXPECT_FALSE(r.levels[j].deformed) << j;
+      EXPECT_EQ(r.levels[j].snake.iterations, 0) << j;
+    }
   }
+  // The initial fit and the coarser levels are the same run either way.
+  EXPECT_EQ(with.initial_pose.scale, without.initial_pose.scale);
+  EXPECT_EQ(with.initial_pose.translation, without.initial_pose.translation);
+  EXPECT_EQ(with.initial_pose.rotation, without.initial_pose.rotation);
   for (int j = 0; j < fine_levels.front(); ++j) {
     EXPECT_TRUE(without.levels[j].deformed) << j;
     EXPECT_EQ(with.levels[j].offset_smoothing, options.snake.offset_smoothing) << j;
+    EXPECT_EQ(with.levels[j].surface.V, without.levels[j].surface.V) << j;
   }
   EXPECT_EQ(with.self_intersections, 0);
   const double dice_with = evaluate_segmentation(rasterize_mesh(with.surface, target.truth), target.truth).dice;

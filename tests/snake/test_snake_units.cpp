@@ -4,7 +4,9 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <filesystem>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <set>
 
@@ -22,6 +24,7 @@
 #include "snake/sampler.h"
 #include "snake/segment.h"
 #include "snake/surface_geometry.h"
+#include "tests/test_support.h"
 
 using namespace mrsnake;
 
@@ -821,11 +824,11 @@ TEST(Appearance, ProfilesCentredOnTheImagesEdgesUndoTheLabelsRounding) {
   // Each level records where its profiles sit: exactly the aligned ones on the edges.
   int flagged = 0;
   for (std::size_t j = 0; j < on_edges.levels.size(); ++j) {
-    flagged += on_edges.levels[j].centred_on_edges ? 1 : 0;
-    EXPECT_FALSE(on_labels.levels[j].centred_on_edges) << j;
+    flagged += on_edges.levels[j].centre == ProfileCentre::edges ? 1 : 0;
+    EXPECT_EQ(on_labels.levels[j].centre, ProfileCentre::labels) << j;
   }
   EXPECT_EQ(flagged, edges.levels_aligned);
-  EXPECT_TRUE(on_edges.levels[finest].centred_on_edges);
+  EXPECT_EQ(on_edges.levels[finest].centre, ProfileCentre::edges);
   // The centre sample: the midpoint 0.5 on the edge, about 0.8 at the label's surface.
   EXPECT_NEAR(on_edges.levels[finest].profiles.col(half).mean(), 0.5, 0.06);
   EXPECT_GT(on_labels.levels[finest].profiles.col(half).mean(), 0.7);
@@ -866,28 +869,37 @@ TEST(Appearance, SerializationRoundTripsAndRejectsDamage) {
   a.levels[0].profiles = Eigen::MatrixXf::Random(12, 5);
   a.levels[1].spacing_mm = 1;
   a.levels[1].profiles = Eigen::MatrixXf::Random(42, 5);
-  a.levels[1].centred_on_edges = true;
+  a.levels[1].centre = ProfileCentre::edges;
   const auto bytes = serialize_appearance(a);
   const Appearance b = deserialize_appearance(bytes);
   EXPECT_EQ(b.half_length, 2);
   EXPECT_DOUBLE_EQ(b.region.inside, 0.8);
   ASSERT_EQ(b.levels.size(), 2u);
   EXPECT_EQ(b.levels[1].profiles, a.levels[1].profiles);
-  EXPECT_FALSE(b.levels[0].centred_on_edges);
-  EXPECT_TRUE(b.levels[1].centred_on_edges);
-  // Version 01 (models built before the flag): the same layout without the flag byte after
-  // each level's spacing; every level reads as centred on the labels.
+  EXPECT_EQ(b.levels[0].centre, ProfileCentre::labels);
+  EXPECT_EQ(b.levels[1].centre, ProfileCentre::edges);
+  // Version 01, as the old writer wrote it (the fuzz corpus's seed, after its selector byte):
+  // the same layout without the flag byte; the centring reads as unrecorded. Its version 02
+  // twin (a flag byte after each spacing, the last level on the edges) reads the same profiles.
   {
-    const std::size_t header = 8 + 2 * 4 + 5 * 8, level0 = 8 + 1 + 2 * 4 + 12 * 5 * 4;
-    std::vector<std::uint8_t> old_bytes = bytes;
-    old_bytes.erase(old_bytes.begin() + static_cast<long>(header + level0 + 8));  // level 1's flag
-    old_bytes.erase(old_bytes.begin() + static_cast<long>(header + 8));           // level 0's flag
-    old_bytes[7] = '1';
-    const Appearance c = deserialize_appearance(old_bytes);
-    ASSERT_EQ(c.levels.size(), 2u);
-    EXPECT_EQ(c.levels[1].profiles, a.levels[1].profiles);
-    EXPECT_FALSE(c.levels[0].centred_on_edges);
-    EXPECT_FALSE(c.levels[1].centred_on_edges);
+    const auto seed = [](const char* name) {
+      const auto all = test::read_all(std::filesystem::path(MRSNAKE_SOURCE_DIR) / "tests/fuzz/corpus/model_sections" / name);
+      return std::vector<std::uint8_t>(all.begin() + 1, all.end());
+    };
+    const Appearance old = deserialize_appearance(seed("appearance_two_levels"));
+    const Appearance current = deserialize_appearance(seed("appearance_two_levels_v02"));
+    ASSERT_EQ(old.levels.size(), 2u);
+    ASSERT_EQ(current.levels.size(), 2u);
+    for (int j = 0; j < 2; ++j) {
+      EXPECT_EQ(old.levels[j].centre, ProfileCentre::unrecorded) << j;
+      EXPECT_EQ(old.levels[j].profiles, current.levels[j].profiles) << j;
+    }
+    EXPECT_EQ(current.levels[0].centre, ProfileCentre::labels);
+    EXPECT_EQ(current.levels[1].centre, ProfileCentre::edges);
+    nlohmann::json summary = old;
+    EXPECT_EQ(summary["profiles_centred_on"], nlohmann::json({"unrecorded", "unrecorded"}));
+    summary = current;
+    EXPECT_EQ(summary["profiles_centred_on"], nlohmann::json({"labels", "edges"}));
   }
   auto flag = bytes;
   flag[8 + 2 * 4 + 5 * 8 + 8] = 2;  // level 0's flag: neither 0 nor 1
