@@ -35,7 +35,6 @@ double mean_edge_length(const RowMatrixX3d& V, const RowMatrixX3i& F) {
 }
 
 namespace {
-
 void median_and_spread(std::vector<float>& a, double& median, double& spread) {
   if (a.empty()) {
     median = spread = 0;
