@@ -18,7 +18,10 @@ enum class DomainKind { sphere, disk };
 
 /// det(a, b, c): positive for a triangle of D that is not flipped.
 inline double domain_orientation(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  return a.dot(b.cross(c));
+  // a·((b − a) × (c − a)) equals a·(b × c), but from the edges: for a triangle of size ε the
+  // cross product of the corners is ~ε with rounding ~1e-16 across it, which swamps ε² below
+  // ε ~ 1e-8, while the edges' cross product is ~ε² with rounding ~1e-16·ε.
+  return a.dot((b - a).cross(c - a));
 }
 
 /// Brings a point back onto D: onto the sphere, or onto the plane z = 1 (and onto the unit

@@ -7,6 +7,7 @@
 #include <complex>
 #include <limits>
 #include <numeric>
+#include <queue>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -32,9 +33,55 @@ double min_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen
   return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
 }
 
-// The vertex whose star is best shaped (valence 5..7 preferred): its star becomes the cap
-// around the pole.
-int choose_puncture_vertex(const TriMesh& mesh) {
+// Beyond this spread of the area stretch (orders of magnitude), one chart cannot carry the
+// surface: the remeshing's sizes would span more than doubles resolve.
+constexpr double max_stretch_spread_log10 = 12.0;
+
+// Spread of the area distortion, ignoring the 0.1 % most extreme faces on each side.
+// \pre `sorted` is sorted and not empty.
+double spread_of_sorted_log10(const std::vector<double>& sorted) {
+  const std::size_t m = sorted.size();
+  return std::log10(sorted[m - 1 - m / 1000] / sorted[m / 1000]);
+}
+
+// The same spread for a map of `mesh` onto `domain` (infinite for a face flat in either).
+double stretch_spread_log10(const TriMesh& mesh, const RowMatrixX3d& domain) {
+  std::vector<double> stretch(static_cast<std::size_t>(mesh.num_faces()));
+  for (int f = 0; f < mesh.num_faces(); ++f) stretch[f] = face_area(mesh.V, mesh.F, f) / face_area(domain, mesh.F, f);
+  std::sort(stretch.begin(), stretch.end());
+  if (stretch.empty()) return 0;
+  if (!(stretch.front() > 0) || !std::isfinite(stretch.back())) return std::numeric_limits<double>::infinity();
+  return spread_of_sorted_log10(stretch);
+}
+
+// Shortest-path lengths along the edges from `source` to every vertex (Dijkstra).
+std::vector<double> edge_path_lengths(const TriMesh& mesh, const VertexStars& stars, int source) {
+  const int n = mesh.num_vertices();
+  std::vector<double> dist(n, std::numeric_limits<double>::infinity());
+  using Entry = std::pair<double, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
+  dist[source] = 0;
+  queue.emplace(0.0, source);
+  while (!queue.empty()) {
+    const auto [d, v] = queue.top();
+    queue.pop();
+    if (d > dist[v]) continue;
+    for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i)
+      for (int k = 0; k < 3; ++k) {
+        const int w = mesh.F(stars.faces[i], k);
+        const double dw = d + (mesh.V.row(w) - mesh.V.row(v)).norm();
+        if (dw < dist[w]) {
+          dist[w] = dw;
+          queue.emplace(dw, w);
+        }
+      }
+  }
+  return dist;
+}
+
+// How well shaped each vertex's star is as the cap around the pole: its smallest angle, one
+// radian less off valence 5..7.
+std::vector<double> puncture_scores(const TriMesh& mesh) {
   const int n = mesh.num_vertices();
   std::vector<int> valence(n, 0);
   std::vector<double> worst(n, M_PI);
@@ -45,15 +92,43 @@ int choose_puncture_vertex(const TriMesh& mesh) {
       worst[mesh.F(f, k)] = std::min(worst[mesh.F(f, k)], m);
     }
   }
-  int best = 0;
-  double best_score = -1;
-  for (int v = 0; v < n; ++v) {
-    const double score = worst[v] - (valence[v] >= 5 && valence[v] <= 7 ? 0.0 : 1.0);
-    if (score > best_score) {
-      best_score = score;
-      best = v;
-    }
-  }
+  std::vector<double> score(n);
+  for (int v = 0; v < n; ++v) score[v] = worst[v] - (valence[v] >= 5 && valence[v] <= 7 ? 0.0 : 1.0);
+  return score;
+}
+
+// The vertex whose star is best shaped: its star becomes the cap around the pole.
+int choose_puncture_vertex(const TriMesh& mesh) {
+  const std::vector<double> score = puncture_scores(mesh);
+  return static_cast<int>(std::max_element(score.begin(), score.end()) - score.begin());
+}
+
+// A well-shaped vertex near the middle of the surface along its longest path. The ends of a
+// double sweep (the farthest vertex from any vertex, then the farthest from that one) span the
+// shape; the candidates are the vertices whose larger path length to the two ends is within
+// 5 % of the ends' distance of the smallest. A map punctured at one end of a long shape
+// squeezes the other end over the whole length (exponentially, as a conformal map of a tube
+// does), beyond what doubles resolve; punctured in the middle, each end over half of it.
+int choose_central_puncture_vertex(const TriMesh& mesh) {
+  const VertexStars stars(mesh.F, mesh.num_vertices());
+  const auto farthest = [](const std::vector<double>& d) {
+    int best = 0;
+    for (int v = 0; v < static_cast<int>(d.size()); ++v)
+      if (std::isfinite(d[v]) && d[v] > d[best]) best = v;
+    return best;
+  };
+  const int a = farthest(edge_path_lengths(mesh, stars, 0));
+  const std::vector<double> from_a = edge_path_lengths(mesh, stars, a);
+  const int b = farthest(from_a);
+  const std::vector<double> from_b = edge_path_lengths(mesh, stars, b);
+  const int n = mesh.num_vertices();
+  double centre = std::numeric_limits<double>::infinity();
+  for (int v = 0; v < n; ++v) centre = std::min(centre, std::max(from_a[v], from_b[v]));
+  const double tolerance = 0.05 * from_a[b];
+  const std::vector<double> score = puncture_scores(mesh);
+  int best = -1;
+  for (int v = 0; v < n; ++v)
+    if (std::max(from_a[v], from_b[v]) <= centre + tolerance && (best < 0 || score[v] > score[best])) best = v;
   return best;
 }
 
@@ -342,9 +417,8 @@ bool glue_hemispheres(const TriMesh& mesh, const std::array<Piece, 2>& halves, s
 // The punctured map: the star of one well-shaped vertex removed, the rest mapped to the unit
 // disk and lifted onto the sphere by inverse stereographic projection from that vertex, which
 // goes to the pole (0, 0, 1). Returns the pole vertex.
-int punctured_sphere_map(const TriMesh& mesh, RowMatrixX3d& domain) {
+void punctured_sphere_map(const TriMesh& mesh, int pole, RowMatrixX3d& domain) {
   const int n = mesh.num_vertices();
-  const int pole = choose_puncture_vertex(mesh);
   std::vector<int> keep;
   for (int f = 0; f < mesh.num_faces(); ++f)
     if (mesh.F(f, 0) != pole && mesh.F(f, 1) != pole && mesh.F(f, 2) != pole) keep.push_back(f);
@@ -357,7 +431,6 @@ int punctured_sphere_map(const TriMesh& mesh, RowMatrixX3d& domain) {
     domain.row(disk.to_surface[i]) << 2 * x / (1 + s), 2 * y / (1 + s), (s - 1) / (1 + s);
   }
   domain.row(pole) << 0, 0, 1;
-  return pole;
 }
 
 // The two-halves map: the surface cut into two disks, each mapped to the unit disk on its own
@@ -448,20 +521,47 @@ Parameterization parameterize(const TriMesh& input, const ParameterizationOption
     const auto solve_start = std::chrono::steady_clock::now();
     const bool cut = halves && two_halves_sphere_map(mesh, param.domain, param.cut, param.summary);
     param.sphere_map = cut ? SphereMap::two_halves : SphereMap::punctured;
+    const auto orient_and_balance = [&] {
+      int negative = 0;
+      for (int f = 0; f < mesh.num_faces(); ++f)
+        if (domain_orientation(param.domain.row(mesh.F(f, 0)), param.domain.row(mesh.F(f, 1)),
+                               param.domain.row(mesh.F(f, 2))) < 0)
+          ++negative;
+      if (2 * negative > mesh.num_faces()) param.domain.col(0) *= -1.0;  // the disk maps' orientation is CGAL's
+      balance_iterations = balance_sphere(param.domain, weights);
+    };
     if (param.sphere_map == SphereMap::punctured) {
-      const int pole = punctured_sphere_map(mesh, param.domain);
+      int pole = choose_puncture_vertex(mesh);
+      punctured_sphere_map(mesh, pole, param.domain);
+      orient_and_balance();
+      // Punctured near one end, a long shape can lose its other end's triangles to rounding,
+      // or stretch beyond the limit: then once more from a pole near the middle, which is kept
+      // if it flips fewer triangles (or as few, and stretches less).
+      const int flipped_first = count_flipped(param.domain, mesh.F);
+      const double spread_first = stretch_spread_log10(mesh, param.domain);
+      if (flipped_first > 0 || spread_first > max_stretch_spread_log10) {
+        const int central = choose_central_puncture_vertex(mesh);
+        RowMatrixX3d first = param.domain;
+        const int first_iterations = balance_iterations;
+        punctured_sphere_map(mesh, central, param.domain);
+        orient_and_balance();
+        const int flipped_central = count_flipped(param.domain, mesh.F);
+        if (flipped_central < flipped_first ||
+            (flipped_central == flipped_first && stretch_spread_log10(mesh, param.domain) < spread_first)) {
+          param.summary["pole_moved_to_the_middle"] = true;
+          pole = central;
+        } else {
+          param.domain = std::move(first);
+          balance_iterations = first_iterations;
+        }
+      }
       param.summary["pole_vertex"] = pole;
+    } else {
+      orient_and_balance();
     }
     param.summary["sphere_map"] = param.sphere_map == SphereMap::two_halves ? "two_halves" : "punctured";
     // The sphere map's whole time: the cut search or the puncture, and the solve(s).
     param.summary["solver_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
-    int negative = 0;
-    for (int f = 0; f < mesh.num_faces(); ++f)
-      if (domain_orientation(param.domain.row(mesh.F(f, 0)), param.domain.row(mesh.F(f, 1)),
-                             param.domain.row(mesh.F(f, 2))) < 0)
-        ++negative;
-    if (2 * negative > mesh.num_faces()) param.domain.col(0) *= -1.0;  // the disk maps' orientation is CGAL's
-    balance_iterations = balance_sphere(param.domain, weights);
   }
 
   const int flipped = count_flipped(param.domain, mesh.F);
@@ -489,16 +589,15 @@ Parameterization parameterize(const TriMesh& input, const ParameterizationOption
   }
   param.vertex_stretch = area3.cwiseQuotient(aread);
   const double mean_stretch = total3 / totald;
-  // Spread of the distortion, ignoring the 0.1% most extreme faces on each side.
   std::vector<double> sorted(param.face_stretch.data(), param.face_stretch.data() + m);
   std::sort(sorted.begin(), sorted.end());
-  const double lo = sorted[m / 1000], hi = sorted[m - 1 - m / 1000];
   if (!std::isfinite(param.vertex_stretch.sum()) || !(sorted.front() > 0) || !std::isfinite(sorted.back()))
     throw AlgorithmError("the parameterization is degenerate (zero-area triangles in the domain); the surface cannot "
                          "be parameterized well: repair degenerate triangles first");
-  if (hi / lo > 1e12)
+  const double spread_log10 = spread_of_sorted_log10(sorted);
+  if (spread_log10 > max_stretch_spread_log10)
     throw AlgorithmError("the parameterization is too distorted (area stretch spans " +
-                         std::to_string(static_cast<int>(std::log10(hi / lo))) +
+                         std::to_string(static_cast<int>(spread_log10)) +
                          " orders of magnitude): long protrusions cannot be remeshed from one chart; simplify the shape");
 
   param.summary["method"] =
@@ -511,7 +610,7 @@ Parameterization parameterize(const TriMesh& input, const ParameterizationOption
   param.summary["balance_iterations"] = balance_iterations;
   param.summary["stretch_min"] = sorted.front() / mean_stretch;
   param.summary["stretch_max"] = sorted.back() / mean_stretch;
-  param.summary["stretch_spread_log10"] = std::log10(hi / lo);
+  param.summary["stretch_spread_log10"] = spread_log10;
   param.summary["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return param;
 }

@@ -237,3 +237,23 @@ TEST(SphereMap, FallsBackToThePuncturedMapWhenNoPlaneCutsTwoDisks) {
   EXPECT_EQ(p.summary.value("sphere_map_fallback", ""), "no principal plane cuts the surface into two disks");
   EXPECT_EQ(count_flipped(p.domain, p.surface.F), 0);
 }
+
+TEST(DomainOrientation, ResolvesTinyTrianglesOnTheSphere) {
+  // A long shape's sphere map squeezes its far end into triangles far smaller than the
+  // rounding of a coordinate (1e-16) allows a determinant of three corners to see: the
+  // orientation must come from the edges. For corners a, a + ε·t1, a + ε·t2 (projected onto
+  // the sphere) with t1 × t2 = a, it is ε² to first order, and −ε² the other way round.
+  const Eigen::Vector3d a = Eigen::Vector3d(0.3, -0.5, 0.81).normalized();
+  const Eigen::Vector3d t1 = a.unitOrthogonal(), t2 = a.cross(t1);
+  for (const double eps : {1e-3, 1e-6, 1e-9, 1e-11, 1e-13}) {
+    const Eigen::Vector3d b = (a + eps * t1).normalized(), c = (a + eps * t2).normalized();
+    const double o = domain_orientation(a, b, c);
+    EXPECT_NEAR(o / (eps * eps), 1.0, 1e-2) << "edge " << eps;
+    EXPECT_LT(domain_orientation(a, c, b), 0.0) << "edge " << eps;
+    RowMatrixX3d D(3, 3);
+    D << a.transpose(), b.transpose(), c.transpose();
+    RowMatrixX3i F(2, 3);
+    F << 0, 1, 2, 0, 2, 1;
+    EXPECT_EQ(count_flipped(D, F), 1) << "edge " << eps;
+  }
+}

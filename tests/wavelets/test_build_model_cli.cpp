@@ -227,3 +227,51 @@ TEST(BuildModelCli, CloseTunnelsMakesAGenusOneLabelModelable) {
   const ShapeModel m = load_model(model, {true});
   EXPECT_EQ(m.levels(), summary["levels"].get<int>());
 }
+
+namespace {
+
+/// A capsule of label 1 along x: radius `radius` voxels, `length` voxels between the centres of
+/// its caps, in a grid 20 voxels longer and 24 voxels across.
+std::string write_tube_labels(const std::filesystem::path& dir, int length, double radius) {
+  Volume v;
+  v.size = {static_cast<std::size_t>(length) + 20, 24, 24};
+  v.data.assign(v.num_voxels(), 0.0f);
+  for (std::size_t k = 0; k < v.size[2]; ++k)
+    for (std::size_t j = 0; j < v.size[1]; ++j)
+      for (std::size_t i = 0; i < v.size[0]; ++i) {
+        const double axis = std::clamp(static_cast<double>(i), 10.0, 10.0 + length);
+        const double x = i - axis, y = j - 11.5, z = k - 11.5;
+        if (x * x + y * y + z * z <= radius * radius) v.at(i, j, k) = 1.0f;
+      }
+  const std::string path = (dir / ("tube" + std::to_string(length) + ".nii.gz")).string();
+  write_volume(path, v, VoxelType::uint8);
+  return path;
+}
+
+}  // namespace
+
+TEST(BuildModelCli, LongTubesArePuncturedInTheMiddleAndTheTooLongRefusedAsTooDistorted) {
+  // A one-chart sphere map squeezes a tube's far end exponentially in its length over its
+  // radius. Punctured at one cap, a 70-voxel tube of radius 2.5 stretched past the limit
+  // (12 orders of magnitude) and a 100-voxel one lost 241 triangles to rounding, which the
+  // message blamed on degenerate triangles. Punctured near the middle, the first is modelled;
+  // the second is refused for its distortion, which is what is wrong with it.
+  const auto dir = scratch_dir("build-model-cli-tube");
+  const std::string model = (dir / "tube.model").string();
+  const auto built = run_mrsnake("-q build-model --labels " + write_tube_labels(dir, 70, 2.5) + " --label 1 -o " + model +
+                                 " --faces 2048 --json");
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  const auto summary = nlohmann::json::parse(built.output);
+  EXPECT_EQ(summary["faces"], 2048);
+  EXPECT_GT(summary["finest_level_quality"]["min_angle_deg"].get<double>(), 25.0);
+  std::filesystem::remove_all(model);
+
+  const auto r = run_mrsnake("-q build-model --labels " + write_tube_labels(dir, 100, 2.5) + " --label 1 -o " + model +
+                             " --faces 2048");
+  EXPECT_EQ(r.exit_code, 5) << r.output;
+  EXPECT_NE(r.output.find("the parameterization is too distorted (area stretch spans "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("long protrusions cannot be remeshed from one chart"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("flipped"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(model));
+  std::filesystem::remove_all(dir);
+}
