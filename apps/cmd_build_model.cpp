@@ -14,6 +14,7 @@
 #include "mesh/distance.h"
 #include "mesh/errors.h"
 #include "mesh/image_io.h"
+#include "mesh/label_repair.h"
 #include "mesh/marching_cubes.h"
 #include "mesh/quality.h"
 #include "remesh/remesh.h"
@@ -28,7 +29,7 @@ void add_build_model_command(CLI::App& app) {
                                  "semi-regular remeshing, lifting-wavelet analysis");
   struct Args {
     std::string labels, output, predict = "butterfly", image;
-    int label = 1, levels = 0, faces = 32768, smooth = 20, close_tunnels = 0;
+    int label = 1, levels = 0, faces = 32768, smooth = 20, close_tunnels = 0, component = 0;
     double mc_spacing = -1;  // automatic: see --mc-spacing
     bool full_report = false, json = false, compare_unrelaxed = false;
     double reference_margin_mm = 20.0;
@@ -72,6 +73,11 @@ void add_build_model_command(CLI::App& app) {
                   "If the label's surface is not genus 0, close the label with radii up to this many voxels until it "
                   "is (as 'mrsnake mc --close-tunnels'); 0 = no repair")
       ->check(CLI::Range(0, 20));
+  cmd->add_option("--component", a->component,
+                  "Model only the label's K-th largest connected part (1 = the largest), e.g. one of a left and a right "
+                  "organ that share a label; its other parts count as background, in the appearance too; 0 = the "
+                  "whole label (its largest surface is modelled)")
+      ->check(CLI::Range(0, 1000));
   auto* image_option = cmd->add_option("--image", a->image,
                   "Reference intensity image of the labels (same physical space): stores the appearance "
                   "(profiles along the normals, inside/outside statistics) that 'mrsnake segment' matches, and a "
@@ -109,7 +115,8 @@ void add_build_model_command(CLI::App& app) {
     const auto t_start = t;
 
     report(progress, "reading " + a->labels, 0.0);
-    const Volume labels = read_volume(a->labels);
+    const Volume labels =
+        a->component > 0 ? keep_label_part(read_volume(a->labels), a->label, a->component) : read_volume(a->labels);
     lap("read");
 
     // 1.2 mm keeps the liver's thin parts (docs/bench-build-model.md). An image whose voxels
@@ -135,7 +142,8 @@ void add_build_model_command(CLI::App& app) {
           ", or fill them in the label volume");
     if (!surface.dropped_component_faces.empty())
       warn("label " + std::to_string(a->label) + " has " + std::to_string(surface.components_found) +
-           " connected surfaces; the model uses the largest");
+           " connected surfaces; the model uses the largest" +
+           (a->component > 0 ? std::string() : std::string(" (--component K models the K-th largest part of the label)")));
     if (surface.closing_radius > 0)
       warn("label " + std::to_string(a->label) + " had a genus-" + std::to_string(surface.genus_before_repair) +
            " surface; closed its tunnels with a radius of " + std::to_string(surface.closing_radius) + " voxels");
@@ -182,6 +190,7 @@ void add_build_model_command(CLI::App& app) {
 
     model.source_image = a->labels;
     model.source_label = a->label;
+    if (a->component > 0) model.source_component = a->component;
     PhysicalFrame frame;
     frame.size = labels.size;
     frame.spacing = labels.spacing;

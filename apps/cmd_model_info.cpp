@@ -70,7 +70,10 @@ void add_model_info_command(CLI::App& app) {
       std::cout << *model_path << ": mrsnake model, format version " << manifest["format_version"] << '\n';
       if (!model.source_image.empty() || model.source_label)
         std::cout << "  source            " << model.source_image
-                  << (model.source_label ? ", label " + std::to_string(*model.source_label) : std::string()) << '\n';
+                  << (model.source_label ? ", label " + std::to_string(*model.source_label) : std::string())
+                  << (model.source_component ? ", its part " + std::to_string(*model.source_component) + " by size"
+                                             : std::string())
+                  << '\n';
       if (model.physical_frame) {
         const PhysicalFrame& f = *model.physical_frame;
         std::cout << "  image grid        " << f.size[0] << "x" << f.size[1] << "x" << f.size[2] << " voxels of "

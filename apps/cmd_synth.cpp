@@ -8,6 +8,7 @@
 #include "mesh/atomic_file.h"
 #include "mesh/errors.h"
 #include "mesh/image_io.h"
+#include "mesh/label_repair.h"
 #include "mesh/mesh_io.h"
 #include "mesh/topology.h"
 #include "snake/synth.h"
@@ -56,7 +57,7 @@ void add_synth_command(CLI::App& app) {
     std::string out, shape = "sphere", size = "64", spacing = "1", noise = "gaussian", contrast = "200,50", pose = "none";
     std::string from_image, from_labels, params;
     double snr = 10, blur = 0.5, bias = 0, deform = 0;
-    int label = 1, supersampling = 4;
+    int label = 1, supersampling = 4, component = 0;
     std::uint64_t seed = 1;
     bool json = false;
   };
@@ -83,6 +84,12 @@ void add_synth_command(CLI::App& app) {
   auto* from_image = cmd->add_option("--from-image", a->from_image, "Warp this real image instead of rendering a shape (adds no noise or blur unless --noise, --snr or --blur is given)");
   auto* from_labels = cmd->add_option("--from-labels", a->from_labels, "The label volume of --from-image");
   cmd->add_option("--label", a->label, "The label of --from-labels that becomes the truth")->capture_default_str();
+  auto* component = cmd->add_option("--component", a->component,
+                                    "Only the label's K-th largest connected part becomes the truth (1 = the largest; as "
+                                    "'build-model --component'); 0 = all of it")
+                        ->check(CLI::Range(0, 1000))
+                        ->capture_default_str();
+  component->needs(from_labels);
   auto* params = cmd->add_option("--params", a->params, "Regenerate the case recorded in this params.json");
   from_image->needs(from_labels);
   from_labels->needs(from_image);
@@ -96,9 +103,14 @@ void add_synth_command(CLI::App& app) {
   cmd->callback([cmd, a] {
     SynthParams params;
     Volume source_image, source_labels;
+    // The label volume as the truth sees it: with --component, the other parts are background.
+    const auto read_source_labels = [](const SynthOptions& o) {
+      Volume labels = read_volume(o.source_labels);
+      return o.source_component > 0 ? keep_label_part(labels, o.source_label, o.source_component) : labels;
+    };
     if (!a->params.empty()) {
       for (const char* option : {"--shape", "--size", "--spacing", "--noise", "--snr", "--blur", "--bias", "--contrast", "--pose",
-                                 "--deform", "--seed", "--supersampling", "--label"})
+                                 "--deform", "--seed", "--supersampling", "--label", "--component"})
         if (cmd->count(option) > 0)
           throw CLI::ValidationError(option, "--params regenerates the recorded case as it was; drop " + std::string(option) +
                                                  " or drop --params");
@@ -139,8 +151,9 @@ void add_synth_command(CLI::App& app) {
         o.source_image = std::filesystem::absolute(a->from_image).string();
         o.source_labels = std::filesystem::absolute(a->from_labels).string();
         o.source_label = a->label;
+        o.source_component = a->component;
         source_image = read_volume(a->from_image);
-        source_labels = read_volume(a->from_labels);
+        source_labels = read_source_labels(o);
         const Volume mask = label_mask(source_labels, a->label);
         params = draw_synth_params(o, &mask);
       }
@@ -148,7 +161,7 @@ void add_synth_command(CLI::App& app) {
     }
     if (params.options.from_image() && source_image.data.empty()) {
       source_image = read_volume(params.options.source_image);
-      source_labels = read_volume(params.options.source_labels);
+      source_labels = read_source_labels(params.options);
     }
     ensure_writable_directory(a->out);
     const auto progress = terminal_progress();

@@ -4,9 +4,15 @@
 #include <itkBinaryBallStructuringElement.h>
 #include <itkBinaryFillholeImageFilter.h>
 #include <itkBinaryMorphologicalClosingImageFilter.h>
+#include <itkConnectedComponentImageFilter.h>
 #include <itkConstantPadImageFilter.h>
 #include <itkImage.h>
 #include <itkRegionOfInterestImageFilter.h>
+#include <itkRelabelComponentImageFilter.h>
+
+#include <string>
+
+#include "mesh/errors.h"
 
 namespace mrsnake {
 
@@ -54,6 +60,41 @@ Volume close_label(const Volume& labels, int label, int radius_voxels) {
   Volume out = labels;
   const unsigned char* r = fill->GetOutput()->GetBufferPointer();
   for (std::size_t i = 0; i < out.num_voxels(); ++i) out.data[i] = r[i];
+  return out;
+}
+
+Volume keep_label_part(const Volume& labels, int label, int rank) {
+  using Mask = itk::Image<unsigned char, 3>;
+  using Parts = itk::Image<unsigned int, 3>;
+  auto mask = Mask::New();
+  Mask::RegionType region;
+  for (int d = 0; d < 3; ++d) region.SetSize(d, labels.size[d]);
+  mask->SetRegions(region);
+  mask->Allocate();
+  const auto target = static_cast<float>(label);
+  unsigned char* m = mask->GetBufferPointer();
+  for (std::size_t i = 0; i < labels.num_voxels(); ++i) m[i] = labels.data[i] == target ? 1 : 0;
+
+  auto components = itk::ConnectedComponentImageFilter<Mask, Parts>::New();
+  components->SetInput(mask);
+  components->SetFullyConnected(false);
+  // Renumbered by size, largest first (ties keep the scan order of their first voxel).
+  auto by_size = itk::RelabelComponentImageFilter<Parts, Parts>::New();
+  by_size->SetInput(components->GetOutput());
+  by_size->SetSortByObjectSize(true);
+  by_size->Update();
+  const auto parts = static_cast<int>(by_size->GetNumberOfObjects());
+  if (parts == 0)
+    throw InputError("label " + std::to_string(label) + " has no voxel; pick a label that is present with --label");
+  if (rank > parts)
+    throw InputError("label " + std::to_string(label) + " has " + std::to_string(parts) + " connected part" +
+                     (parts == 1 ? "" : "s") + ", so there is no part " + std::to_string(rank) + "; give --component 1" +
+                     (parts == 1 ? "" : " to " + std::to_string(parts)));
+
+  Volume out = labels;
+  const unsigned int* p = by_size->GetOutput()->GetBufferPointer();
+  for (std::size_t i = 0; i < out.num_voxels(); ++i)
+    if (m[i] != 0 && p[i] != static_cast<unsigned int>(rank)) out.data[i] = 0.0f;
   return out;
 }
 

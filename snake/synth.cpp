@@ -665,6 +665,7 @@ void to_json(nlohmann::json& j, const SynthParams& p) {
   j["deform_mm"] = o.deform_mm;
   if (o.from_image()) {
     j["source"] = {{"image", o.source_image}, {"labels", o.source_labels}, {"label", o.source_label}};
+    if (o.source_component > 0) j["source"]["component"] = o.source_component;
   } else {
     j["shape"] = to_string(o.shape);
     j["foreground"] = o.foreground;
@@ -741,6 +742,7 @@ SynthParams synth_params_from_json(const nlohmann::json& j) {
       o.source_image = src.at("image").get<std::string>();
       o.source_labels = src.at("labels").get<std::string>();
       o.source_label = src.at("label").get<int>();
+      o.source_component = src.value("component", 0);
     } else {
       o.shape = parse_synth_shape(j.at("shape").get<std::string>());
       o.foreground = j.at("foreground").get<double>();

@@ -61,6 +61,7 @@ struct SynthOptions {
   /// rendering a shape (the shape, contrast and supersampling are then unused).
   std::string source_image, source_labels;
   int source_label = 1;
+  int source_component = 0;  ///< 0: all of the label; k >= 1: only its k-th largest connected part (keep_label_part)
   bool from_image() const { return !source_image.empty(); }
 };
 

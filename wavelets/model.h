@@ -39,6 +39,7 @@ struct ShapeModel {
   // Provenance, written to the manifest.
   std::string source_image;                    ///< the label image (empty if unknown)
   std::optional<int> source_label;
+  std::optional<int> source_component;        ///< the label's k-th largest part only (build-model --component)
   std::optional<PhysicalFrame> physical_frame;
   nlohmann::json remesh_quality;               ///< mesh/quality.h keys; null if none
   std::vector<std::pair<std::string, double>> timings;  ///< seconds per stage, in order

@@ -302,6 +302,7 @@ void save_model(const std::string& folder, const ShapeModel& model, const Progre
                     ? nlohmann::json(nullptr)
                     : nlohmann::json{{"image", model.source_image},
                                      {"label", model.source_label ? nlohmann::json(*model.source_label) : nlohmann::json(nullptr)}};
+  if (model.source_component && !m["source"].is_null()) m["source"]["component"] = *model.source_component;
   if (model.physical_frame) {
     const PhysicalFrame& f = *model.physical_frame;
     m["physical_frame"] = {{"units", "mm"}, {"size", f.size}, {"spacing", f.spacing}, {"origin", f.origin}, {"direction", f.direction}};
@@ -412,6 +413,7 @@ ShapeModel load_model(const std::string& folder, const LoadModelOptions& options
     if (!m.at("source").is_null()) {
       model.source_image = m["source"].at("image").get<std::string>();
       if (!m["source"].at("label").is_null()) model.source_label = m["source"]["label"].get<int>();
+      if (m["source"].contains("component")) model.source_component = m["source"]["component"].get<int>();
     }
     if (!m.at("physical_frame").is_null()) {
       const nlohmann::json& f = m["physical_frame"];

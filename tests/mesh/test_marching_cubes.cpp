@@ -1,9 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "mesh/errors.h"
 #include "mesh/image_io.h"
+#include "mesh/label_repair.h"
 #include "mesh/label_resample.h"
 #include "mesh/marching_cubes.h"
 #include "mesh/mesh_io.h"
@@ -318,4 +320,40 @@ TEST(MarchingCubes, ClosingRepairsATunnelOnlyWhenAsked) {
   // The repair fills the hole but keeps the outside: the volume only grows, and not by much.
   EXPECT_GT(enclosed_volume(repaired.mesh), enclosed_volume(plain.mesh));
   EXPECT_LT(enclosed_volume(repaired.mesh), 1.3 * enclosed_volume(plain.mesh));
+}
+
+TEST(LabelParts, KeepsThePartOfTheRankAskedAndLeavesOtherLabels) {
+  // Label 7 on two balls (radius 5 and 3.5) and on a voxel touching the smaller one only
+  // along an edge (a part of its own: parts are face-connected); label 2 on a third ball.
+  std::size_t big = 0, small = 0, other = 0;
+  Volume labels = voxelized_ball(grid(40, {1, 1, 1}), {10, 10, 10}, 5.0, 7, big);
+  const Volume b = voxelized_ball(grid(40, {1, 1, 1}), {28, 28, 10}, 3.5, 7, small);
+  const Volume c = voxelized_ball(grid(40, {1, 1, 1}), {10, 30, 30}, 4.0, 2, other);
+  for (std::size_t i = 0; i < labels.num_voxels(); ++i) labels.data[i] += b.data[i] + c.data[i];
+  ASSERT_EQ(labels.at(29, 28, 13), 7.f);  // on the top layer of the smaller ball
+  labels.at(30, 28, 14) = 7.f;           // meets (29, 28, 13) along an edge only
+  const auto count = [](const Volume& v, float value) {
+    return static_cast<std::size_t>(std::count(v.data.begin(), v.data.end(), value));
+  };
+  const Volume first = keep_label_part(labels, 7, 1), second = keep_label_part(labels, 7, 2),
+               third = keep_label_part(labels, 7, 3);
+  EXPECT_EQ(count(first, 7.f), big);
+  EXPECT_EQ(first.at(10, 10, 10), 7.f);
+  EXPECT_EQ(count(second, 7.f), small);
+  EXPECT_EQ(second.at(28, 28, 10), 7.f);
+  EXPECT_EQ(count(third, 7.f), 1u);
+  EXPECT_EQ(third.at(30, 28, 14), 7.f);
+  for (const Volume* v : {&first, &second, &third}) {
+    EXPECT_EQ(count(*v, 2.f), other);  // other labels untouched
+    EXPECT_EQ(v->size, labels.size);
+  }
+  try {
+    keep_label_part(labels, 7, 4);
+    ADD_FAILURE() << "a fourth part of three was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("label 7 has 3 connected parts, so there is no part 4; give --component 1 to 3"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(keep_label_part(labels, 9, 1), InputError);
 }

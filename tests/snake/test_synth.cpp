@@ -1,6 +1,7 @@
 // Synthetic cases: exact truth, partial volume, noise, pose, deformation, reproducibility.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -497,6 +498,64 @@ TEST(SynthFromImage, RealBrainMriHippocampus) {
   auto absent = test::run_mrsnake("synth --from-image " + image + " --from-labels " + labels + " --label 77 -o " +
                                   (dir / "absent").string());
   EXPECT_EQ(absent.exit_code, 3) << absent.output;
+  std::filesystem::remove_all(dir);
+}
+
+TEST(SynthFromImage, ComponentMakesTheTruthOfOnePartOfTheLabel) {
+  // Label 5 on two balls (radius 6 about voxel (9, 10, 10), radius 4 about (25, 10, 10)) and
+  // label 2 on a third; the image is bright on all three.
+  const auto dir = test::scratch_dir("synth-parts");
+  Volume labels;
+  labels.size = {34, 20, 20};
+  labels.data.assign(labels.num_voxels(), 0.0f);
+  std::size_t small_voxels = 0;
+  for (std::size_t k = 0; k < labels.size[2]; ++k)
+    for (std::size_t j = 0; j < labels.size[1]; ++j)
+      for (std::size_t i = 0; i < labels.size[0]; ++i) {
+        const double y = j - 10.0, z = k - 10.0, a = i - 9.0, b = i - 25.0, c = i - 25.0, cy = j - 2.0;
+        if (a * a + y * y + z * z <= 36.0) labels.at(i, j, k) = 5.0f;
+        if (b * b + y * y + z * z <= 16.0) {
+          labels.at(i, j, k) = 5.0f;
+          ++small_voxels;
+        }
+        if (c * c + cy * cy + (k - 3.0) * (k - 3.0) <= 2.0) labels.at(i, j, k) = 2.0f;
+      }
+  Volume image = labels;
+  for (float& v : image.data) v = v > 0 ? 100.0f : 20.0f;
+  const std::string image_path = (dir / "image.nii.gz").string(), labels_path = (dir / "labels.nii.gz").string();
+  write_volume(image_path, image, VoxelType::float32);
+  write_volume(labels_path, labels, VoxelType::uint8);
+  const std::string from = "-q synth --from-image " + image_path + " --from-labels " + labels_path + " --label 5 ";
+
+  // No pose and no deformation: the truth is exactly the second part's voxels.
+  const auto r = test::run_mrsnake(from + "--component 2 --seed 4 -o " + (dir / "part2").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Volume truth = read_volume((dir / "part2" / "truth.nii.gz").string());
+  EXPECT_EQ(static_cast<std::size_t>(std::count(truth.data.begin(), truth.data.end(), float(kTruthLabel))), small_voxels);
+  EXPECT_EQ(truth.at(25, 10, 10), float(kTruthLabel));
+  EXPECT_EQ(truth.at(9, 10, 10), 0.0f);
+  const auto params = nlohmann::json::parse(file_bytes(dir / "part2" / "params.json"));
+  EXPECT_EQ(params.at("source").at("component").get<int>(), 2);
+  // Warped, and regenerated from params.json with the same part.
+  const auto warped = test::run_mrsnake(from + "--component 2 --pose random --deform 1.5 --seed 4 -o " +
+                                        (dir / "warped").string());
+  ASSERT_EQ(warped.exit_code, 0) << warped.output;
+  const auto again = test::run_mrsnake("-q synth --params " + (dir / "warped" / "params.json").string() + " -o " +
+                                       (dir / "again").string());
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_EQ(read_volume((dir / "warped" / "truth.nii.gz").string()).data,
+            read_volume((dir / "again" / "truth.nii.gz").string()).data);
+  // Without --component, both balls; a part that does not exist is an input error.
+  const auto both = test::run_mrsnake(from + "--seed 4 -o " + (dir / "both").string());
+  ASSERT_EQ(both.exit_code, 0) << both.output;
+  EXPECT_NE(both.output.find("the label has several parts"), std::string::npos) << both.output;
+  const Volume both_truth = read_volume((dir / "both" / "truth.nii.gz").string());
+  EXPECT_EQ(both_truth.at(9, 10, 10), float(kTruthLabel));
+  EXPECT_EQ(both_truth.at(25, 10, 10), float(kTruthLabel));
+  const auto missing = test::run_mrsnake(from + "--component 3 -o " + (dir / "part3").string());
+  EXPECT_EQ(missing.exit_code, 3) << missing.output;
+  EXPECT_NE(missing.output.find("label 5 has 2 connected parts, so there is no part 3"), std::string::npos) << missing.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "part3" / "truth.nii.gz"));
   std::filesystem::remove_all(dir);
 }
 

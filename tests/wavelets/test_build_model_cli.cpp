@@ -275,3 +275,50 @@ TEST(BuildModelCli, LongTubesArePuncturedInTheMiddleAndTheTooLongRefusedAsTooDis
   EXPECT_FALSE(std::filesystem::exists(model));
   std::filesystem::remove_all(dir);
 }
+
+TEST(BuildModelCli, ComponentModelsOnePartOfALabelAndRecordsIt) {
+  // Label 3 on two balls, like a left and a right organ under one label: radius 7 about
+  // voxel (10, 12, 12) and radius 5 about (30, 12, 12).
+  const auto dir = scratch_dir("build-model-cli-parts");
+  Volume v;
+  v.size = {42, 24, 24};
+  v.data.assign(v.num_voxels(), 0.0f);
+  for (std::size_t k = 0; k < v.size[2]; ++k)
+    for (std::size_t j = 0; j < v.size[1]; ++j)
+      for (std::size_t i = 0; i < v.size[0]; ++i) {
+        const double y = j - 12.0, z = k - 12.0, left = i - 10.0, right = i - 30.0;
+        if (left * left + y * y + z * z <= 49.0 || right * right + y * y + z * z <= 25.0) v.at(i, j, k) = 3.0f;
+      }
+  const std::string labels = (dir / "two.nii.gz").string();
+  write_volume(labels, v, VoxelType::uint8);
+
+  // Without --component: the largest, with a warning that names the option.
+  const std::string whole = (dir / "whole.model").string();
+  const auto w = run_mrsnake("build-model --labels " + labels + " --label 3 -o " + whole + " --faces 512");
+  ASSERT_EQ(w.exit_code, 0) << w.output;
+  EXPECT_NE(w.output.find("2 connected surfaces; the model uses the largest (--component K models the K-th largest part"),
+            std::string::npos)
+      << w.output;
+  EXPECT_FALSE(load_model(whole, {true}).source_component.has_value());
+
+  for (const int part : {1, 2}) {
+    const std::string model = (dir / ("part" + std::to_string(part) + ".model")).string();
+    const auto r = run_mrsnake("build-model --labels " + labels + " --label 3 --component " + std::to_string(part) +
+                               " -o " + model + " --faces 512");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(r.output.find("connected surfaces"), std::string::npos) << r.output;  // one part: nothing dropped
+    const ShapeModel m = load_model(model, {true});
+    EXPECT_EQ(m.source_component, part);
+    const Eigen::RowVector3d centre = m.level_positions.back().colwise().mean();
+    EXPECT_NEAR(centre.x(), part == 1 ? 10.0 : 30.0, 0.5);
+    EXPECT_NEAR(centre.y(), 12.0, 0.5);
+    const double radius = (m.level_positions.back().rowwise() - centre).rowwise().norm().mean();
+    EXPECT_NEAR(radius, part == 1 ? 7.0 : 5.0, 0.6);
+    const auto info = run_mrsnake("model-info " + model);
+    EXPECT_NE(info.output.find("label 3, its part " + std::to_string(part) + " by size"), std::string::npos) << info.output;
+  }
+  expect_refused("--labels " + labels + " --label 3 --component 3 -o " + (dir / "part3.model").string(), 3,
+                 "label 3 has 2 connected parts, so there is no part 3; give --component 1 to 2",
+                 (dir / "part3.model").string());
+  std::filesystem::remove_all(dir);
+}
