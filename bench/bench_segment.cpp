@@ -555,6 +555,7 @@ void real_cases(Bench& b, const fs::path& data) {
     int label;
     std::vector<std::string> model_options;
     std::string deform_mm;
+    int component = 0;  ///< the label's part by size (build-model and synth --component); 0 = all of it
   };
   const fs::path v = data / "volumes";
   const std::vector<Structure> structures{
@@ -563,6 +564,13 @@ void real_cases(Bench& b, const fs::path& data) {
       {"fourth ventricle (MRIcrop, label 3)", "MRIcrop-orig.gipl.gz", "MRIcrop-seg.gipl.gz", 3, {}, "2"},
       {"right hippocampus (MRIcrop, label 4)", "MRIcrop-orig.gipl.gz", "MRIcrop-seg.gipl.gz", 4, {}, "2"},
       {"left hippocampus (MRIcrop, label 5)", "MRIcrop-orig.gipl.gz", "MRIcrop-seg.gipl.gz", 5, {}, "2"},
+      // Its five specks (8-60 faces) are dropped by the model and stay in the truth.
+      {"corpus callosum (MRIcrop, label 8)", "MRIcrop-orig.gipl.gz", "MRIcrop-seg.gipl.gz", 8, {}, "2"},
+      // Two organs under one label each (left and right): one model and one truth per part.
+      {"caudate, larger part (MRIcrop, label 7)", "MRIcrop-orig.gipl.gz", "MRIcrop-seg.gipl.gz", 7, {}, "2", 1},
+      {"caudate, smaller part (MRIcrop, label 7)", "MRIcrop-orig.gipl.gz", "MRIcrop-seg.gipl.gz", 7, {}, "2", 2},
+      {"temporal horn, larger part (MRIcrop, label 6)", "MRIcrop-orig.gipl.gz", "MRIcrop-seg.gipl.gz", 6, {}, "2", 1},
+      {"temporal horn, smaller part (MRIcrop, label 6)", "MRIcrop-orig.gipl.gz", "MRIcrop-seg.gipl.gz", 6, {}, "2", 2},
   };
   int seed = 7;
   for (const Structure& s : structures) {
@@ -576,12 +584,17 @@ void real_cases(Bench& b, const fs::path& data) {
     fs::create_directories(c.dir);
     c.model = c.dir / "model";
     std::printf("  %s:\n", s.name.c_str());
-    c.model_levels = b.build_model(v / s.labels, s.label, v / s.image, c.model, s.model_options);
+    std::vector<std::string> model_options = s.model_options, part;
+    if (s.component > 0) part = {"--component", std::to_string(s.component)};
+    model_options.insert(model_options.end(), part.begin(), part.end());
+    c.model_levels = b.build_model(v / s.labels, s.label, v / s.image, c.model, model_options);
     // A new case: the same image and label, warped by a known random pose and deformation.
-    b.mrsnake_cmd({"synth", "--from-image", (v / s.image).string(), "--from-labels", (v / s.labels).string(), "--label",
-                   std::to_string(s.label), "--pose", "random", "--deform", s.deform_mm, "--seed",
-                   std::to_string(seed++), "-o", (c.dir / "case").string()},
-                  c.dir, "synth");
+    std::vector<std::string> synth{"synth", "--from-image", (v / s.image).string(), "--from-labels",
+                                   (v / s.labels).string(), "--label", std::to_string(s.label), "--pose", "random",
+                                   "--deform", s.deform_mm, "--seed", std::to_string(seed++), "-o",
+                                   (c.dir / "case").string()};
+    synth.insert(synth.end(), part.begin(), part.end());
+    b.mrsnake_cmd(synth, c.dir, "synth");
     c.image = c.dir / "case" / "image.nii.gz";
     c.truth = c.dir / "case" / "truth.nii.gz";
     b.run_case(c);
