@@ -43,6 +43,7 @@ void add_evaluate_command(CLI::App& app);
 void add_remesh_command(CLI::App& app);
 void add_build_model_command(CLI::App& app);
 void add_segment_command(CLI::App& app);
+void add_segment_batch_command(CLI::App& app);
 
 /// Adds --sphere-map auto|halves|punctured (remesh and build-model), bound to `map`.
 void add_sphere_map_option(CLI::App& command, SphereMap& map);

@@ -1,9 +1,13 @@
 // mrsnake segment: the multiresolution snake on a new volume (see snake/segment.h).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <map>
+#include <vector>
 
 #include "apps/cli.h"
 #include "apps/report/segment_page.h"
@@ -50,32 +54,151 @@ void write_segment_page(const std::filesystem::path& path, const std::string& im
   mrsnake::reports::write_segment_report(path.string(), page);
 }
 
+// One image segmented into an output folder: the image (and truth) read, the snake, the
+// labels and the self-intersection count, then every output written to a temporary folder
+// renamed into place. Returns report.json's content.
+struct SegmentCase {
+  std::string image, truth, output;
+  int truth_label = 1;
+};
+
+struct SegmentCaseOutcome {
+  nlohmann::json report;
+  SegmentResult result;
+};
+
+SegmentCaseOutcome segment_case(const SegmentCase& c, const SnakeModel& model, const std::string& model_path,
+                                const SegmentOptions& options, double model_load_seconds, const ProgressFn& progress) {
+  const auto t_load = std::chrono::steady_clock::now();
+  report(progress, "load", 0.0);
+  const Volume image = read_volume(c.image);
+  Volume truth;
+  if (!c.truth.empty()) {
+    truth = read_volume(c.truth);
+    require_same_grid(image, truth, "IMAGE", "TRUTH");
+  }
+  const double load_seconds =
+      model_load_seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - t_load).count();
+
+  // The self-intersection count runs below, beside the rasterization.
+  SegmentOptions case_options = options;
+  case_options.count_self_intersections = false;
+  SegmentCaseOutcome outcome;
+  SegmentResult& result = outcome.result;
+  result = segment(image, model, case_options, progress);
+  if (result.registration && !result.registration->accepted)
+    warn("the reference image registration was not used (" + result.registration->rejection + "); initialized with " +
+         to_string(result.init) + " instead");
+  report(progress, "rasterize", 0.0);
+  Volume labels;
+  double rasterize_seconds = 0, count_seconds = 0;
+  run_both_in_parallel(
+      [&] {
+        const auto t = std::chrono::steady_clock::now();
+        labels = rasterize_mesh(result.surface, image, 1.0f);
+        rasterize_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+      },
+      [&] {
+        const auto t = std::chrono::steady_clock::now();
+        result.self_intersections = count_self_intersections(result.surface);
+        count_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+      });
+  result.stage_seconds.emplace_back("self_intersections", count_seconds);
+
+  nlohmann::json& rep = outcome.report;
+  rep = segment_report(result);
+  rep["image"] = c.image;
+  rep["model"] = model_path;
+  rep["init"] = to_string(options.init);
+  rep["stage_seconds"]["load"] = load_seconds;
+  rep["stage_seconds"]["rasterize"] = rasterize_seconds;
+  // What a screening study compares: the organ's volume, as labels.nii.gz holds it.
+  const auto inside = static_cast<double>(std::count(labels.data.begin(), labels.data.end(), 1.0f));
+  rep["volume_mm3"] = inside * labels.spacing[0] * labels.spacing[1] * labels.spacing[2];
+  if (!c.truth.empty()) {
+    report(progress, "evaluate", 0.0);
+    nlohmann::json scores;
+    to_json(scores, evaluate_segmentation(labels, truth, 1, c.truth_label));
+    rep["scores"] = scores;
+    rep["truth"] = c.truth;
+  }
+
+  // Everything goes to a temporary folder renamed into place at the end.
+  report(progress, "write", 0.0);
+  AtomicDirectory out(c.output);
+  const std::filesystem::path dir = out.temp_path();
+  std::filesystem::create_directories(dir / "levels");
+  const auto write_meshes = [&] {
+    write_mesh((dir / "surface.vtp").string(), result.surface);
+    for (const LevelOutcome& l : result.levels)
+      write_mesh((dir / "levels" / ("level_" + std::to_string(l.level) + ".vtp")).string(), l.surface);
+    write_text_file_atomically((dir / "report.json").string(), rep.dump(2) + "\n");
+  };
+  // The compressed labels are written on the other core, beside the meshes.
+  run_both_in_parallel(write_meshes, [&] { write_volume((dir / "labels.nii.gz").string(), labels, VoxelType::uint8); });
+  // After the join: the page's render forks a child, which must not start while another
+  // thread may hold a lock (the allocator's, the loader's) that the child would then wait on.
+  write_segment_page(dir / "report.html", c.image, image, c.truth.empty() ? nullptr : &truth, c.truth_label, result,
+                     rep);
+  out.commit();
+  report(progress, "done", 1.0);
+  return outcome;
+}
+
+// The options segment and segment-batch share, and the SegmentOptions they give.
+struct SnakeArgs {
+  std::string init = "auto", force = "auto", register_metric = "mattes";
+  int max_iterations = -1;
+
+  void add_to(CLI::App* cmd) {
+    cmd->add_option("--init", init,
+                    "Initial pose: auto (register+fit if the model has a reference image, else moments+fit), pose, "
+                    "moments, fit, moments+fit, register, register+fit")
+        ->capture_default_str();
+    cmd->add_option("--register-metric", register_metric,
+                    "Metric of --init register: mattes (mutual information) or mean_squares (normalized intensities)")
+        ->capture_default_str();
+    cmd->add_option("--force", force,
+                    "External force: auto (profiles if the model has an appearance, unless they learned a clean step), "
+                    "profile, edge")
+        ->capture_default_str();
+    cmd->add_option("--max-iterations", max_iterations, "Iterations per level at most (default 40)");
+  }
+  SegmentOptions options() const {
+    SegmentOptions o;
+    o.init = parse_init_mode(init);
+    o.registration.itk.metric = parse_registration_metric(register_metric);
+    o.force = parse_force_mode(force);
+    if (max_iterations >= 0) o.snake.max_iterations = max_iterations;
+    return o;
+  }
+};
+
+// The model, read once, and how long that took.
+std::pair<SnakeModel, double> load_snake_model(const std::string& path) {
+  const auto t = std::chrono::steady_clock::now();
+  SnakeModel model = snake_model_from(load_model(path));
+  return {std::move(model), std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count()};
+}
+
 }  // namespace
 
 void add_segment_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("segment", "Segment a volume with a shape model: coarse-to-fine snake, labels, surfaces and a report");
   struct Args {
-    std::string image, model, output, truth, init = "auto", force = "auto", register_metric = "mattes";
-    int truth_label = 1, max_iterations = -1;
+    SegmentCase c;
+    std::string model;
+    SnakeArgs snake;
     bool json = false;
   };
   auto a = std::make_shared<Args>();
-  cmd->add_option("--image", a->image, "Volume to segment (.nii.gz .nrrd .mha ..., or a DICOM folder)")->required();
+  cmd->add_option("--image", a->c.image, "Volume to segment (.nii.gz .nrrd .mha ..., or a DICOM folder)")->required();
   cmd->add_option("--model", a->model, "Shape model folder (made by 'mrsnake build-model')")->required();
-  cmd->add_option("-o,--output", a->output, "Output folder: surface.vtp, labels.nii.gz, levels/level_j.vtp, report.json, report.html")
+  cmd->add_option("-o,--output", a->c.output, "Output folder: surface.vtp, labels.nii.gz, levels/level_j.vtp, report.json, report.html")
       ->required();
-  cmd->add_option("--init", a->init,
-                  "Initial pose: auto (register+fit if the model has a reference image, else moments+fit), pose, "
-                  "moments, fit, moments+fit, register, register+fit")
-      ->capture_default_str();
-  cmd->add_option("--register-metric", a->register_metric,
-                  "Metric of --init register: mattes (mutual information) or mean_squares (normalized intensities)")
-      ->capture_default_str();
-  cmd->add_option("--force", a->force, "External force: auto (profiles if the model has an appearance, unless they learned a clean step), profile, edge")
-      ->capture_default_str();
-  cmd->add_option("--truth", a->truth, "Truth labels on the image's grid: adds the scores of 'mrsnake evaluate' to the report");
-  cmd->add_option("--truth-label", a->truth_label, "Label of the object in --truth")->capture_default_str();
-  cmd->add_option("--max-iterations", a->max_iterations, "Iterations per level at most (default 40)");
+  a->snake.add_to(cmd);
+  cmd->add_option("--truth", a->c.truth, "Truth labels on the image's grid: adds the scores of 'mrsnake evaluate' to the report");
+  cmd->add_option("--truth-label", a->c.truth_label, "Label of the object in --truth")->capture_default_str();
   cmd->add_flag("--json", a->json, "Print the report as JSON on stdout");
   cmd->footer(
       "Example:\n"
@@ -84,86 +207,20 @@ void add_segment_command(CLI::App& app) {
       "DIR/levels/level_j.vtp (each level after deformation), DIR/report.json and DIR/report.html.\n"
       "With a model built by 'build-model --image', the default initialization registers the model's\n"
       "reference image to IMAGE (ITK, similarity), then fits the coarse mesh; report.json's\n"
-      "'registration' holds the transform, the metric and whether it was used or why not.");
+      "'registration' holds the transform, the metric and whether it was used or why not.\n"
+      "Many images with one model: 'mrsnake segment-batch'.");
   cmd->callback([a] {
     const auto progress = terminal_progress();
-    const auto t_load = std::chrono::steady_clock::now();
-    SegmentOptions options;
-    options.init = parse_init_mode(a->init);
-    options.registration.itk.metric = parse_registration_metric(a->register_metric);
-    options.force = parse_force_mode(a->force);
-    if (a->max_iterations >= 0) options.snake.max_iterations = a->max_iterations;
+    const SegmentOptions options = a->snake.options();
     report(progress, "load", 0.0);
-    const Volume image = read_volume(a->image);
-    Volume truth;
-    if (!a->truth.empty()) {
-      truth = read_volume(a->truth);
-      require_same_grid(image, truth, "IMAGE", "TRUTH");
-    }
-    const SnakeModel model = snake_model_from(load_model(a->model));
-    const double load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_load).count();
-
-    // The self-intersection count runs below, beside the rasterization.
-    options.count_self_intersections = false;
-    SegmentResult result = segment(image, model, options, progress);
-    if (result.registration && !result.registration->accepted)
-      warn("the reference image registration was not used (" + result.registration->rejection + "); initialized with " +
-           to_string(result.init) + " instead");
-    report(progress, "rasterize", 0.0);
-    Volume labels;
-    double rasterize_seconds = 0, count_seconds = 0;
-    run_both_in_parallel(
-        [&] {
-          const auto t = std::chrono::steady_clock::now();
-          labels = rasterize_mesh(result.surface, image, 1.0f);
-          rasterize_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-        },
-        [&] {
-          const auto t = std::chrono::steady_clock::now();
-          result.self_intersections = count_self_intersections(result.surface);
-          count_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-        });
-    result.stage_seconds.emplace_back("self_intersections", count_seconds);
-
-    nlohmann::json rep = segment_report(result);
-    rep["image"] = a->image;
-    rep["model"] = a->model;
-    rep["init"] = to_string(options.init);
-    rep["stage_seconds"]["load"] = load_seconds;
-    rep["stage_seconds"]["rasterize"] = rasterize_seconds;
-    if (!a->truth.empty()) {
-      report(progress, "evaluate", 0.0);
-      nlohmann::json scores;
-      to_json(scores, evaluate_segmentation(labels, truth, 1, a->truth_label));
-      rep["scores"] = scores;
-      rep["truth"] = a->truth;
-    }
-
-    // Everything goes to a temporary folder renamed into place at the end.
-    report(progress, "write", 0.0);
-    AtomicDirectory out(a->output);
-    const std::filesystem::path dir = out.temp_path();
-    std::filesystem::create_directories(dir / "levels");
-    const auto write_meshes = [&] {
-      write_mesh((dir / "surface.vtp").string(), result.surface);
-      for (const LevelOutcome& l : result.levels)
-        write_mesh((dir / "levels" / ("level_" + std::to_string(l.level) + ".vtp")).string(), l.surface);
-      write_text_file_atomically((dir / "report.json").string(), rep.dump(2) + "\n");
-    };
-    // The compressed labels are written on the other core, beside the meshes.
-    run_both_in_parallel(write_meshes,
-                         [&] { write_volume((dir / "labels.nii.gz").string(), labels, VoxelType::uint8); });
-    // After the join: the page's render forks a child, which must not start while another
-    // thread may hold a lock (the allocator's, the loader's) that the child would then wait on.
-    write_segment_page(dir / "report.html", a->image, image, a->truth.empty() ? nullptr : &truth, a->truth_label, result,
-                       rep);
-    out.commit();
-    report(progress, "done", 1.0);
-
+    const auto [model, model_seconds] = load_snake_model(a->model);
+    const SegmentCaseOutcome outcome = segment_case(a->c, model, a->model, options, model_seconds, progress);
+    const nlohmann::json& rep = outcome.report;
+    const SegmentResult& result = outcome.result;
     if (a->json) {
       print_json(rep);
     } else {
-      info("segmented " + a->image + " in " + std::to_string(result.compute_seconds) + " s of compute (" +
+      info("segmented " + a->c.image + " in " + std::to_string(result.compute_seconds) + " s of compute (" +
            std::to_string(result.levels.size()) + " levels, " + std::to_string(result.surface.num_vertices()) +
            " vertices, " + std::to_string(result.self_intersections) + " self-intersections)");
       if (rep.contains("scores")) {
@@ -173,8 +230,223 @@ void add_segment_command(CLI::App& app) {
                       rep["scores"]["hd95_mm"].is_null() ? INFINITY : rep["scores"]["hd95_mm"].get<double>());
         info(line);
       }
-      info("wrote " + a->output + "/{surface.vtp, labels.nii.gz, levels/, report.json, report.html}");
+      info("wrote " + a->c.output + "/{surface.vtp, labels.nii.gz, levels/, report.json, report.html}");
     }
+  });
+}
+
+namespace {
+
+// An output folder name per image: the file name without its extensions (a DICOM folder's
+// own name). Names that collide take as many of their parent folders' names in front as
+// tell them apart (study/mouse01/ct.nii.gz: mouse01_ct), then a number.
+std::vector<std::string> case_names(const std::vector<std::string>& images) {
+  struct Entry {
+    std::vector<std::string> parents;  // nearest first
+    std::string name;
+  };
+  std::vector<Entry> entries;
+  for (const std::string& image : images) {
+    std::filesystem::path p = std::filesystem::absolute(image).lexically_normal();
+    if (p.filename().empty()) p = p.parent_path();  // a folder given with a trailing slash
+    Entry e;
+    e.name = p.filename().string();
+    if (e.name.size() > 3 && e.name.compare(e.name.size() - 3, 3, ".gz") == 0) e.name.resize(e.name.size() - 3);
+    if (const auto dot = e.name.rfind('.'); dot != std::string::npos && dot > 0) e.name.resize(dot);
+    if (e.name.empty()) e.name = "image";
+    for (std::filesystem::path q = p.parent_path(); !q.filename().empty(); q = q.parent_path())
+      e.parents.push_back(q.filename().string());
+    entries.push_back(std::move(e));
+  }
+  // Per group of equal names, the fewest parent folders that tell its different paths apart
+  // (the same image given twice stays one name, numbered below).
+  std::map<std::string, std::vector<std::size_t>> groups;
+  for (std::size_t i = 0; i < entries.size(); ++i) groups[entries[i].name].push_back(i);
+  for (const auto& [name, members] : groups) {
+    if (members.size() < 2) continue;
+    const auto prefix = [&](std::size_t i, std::size_t depth) {
+      std::string text;
+      for (std::size_t d = std::min(depth, entries[i].parents.size()); d > 0; --d) text += entries[i].parents[d - 1] + "_";
+      return text;
+    };
+    std::size_t deepest = 0;
+    for (const std::size_t i : members) deepest = std::max(deepest, entries[i].parents.size());
+    std::size_t depth = 1;
+    for (; depth < deepest; ++depth) {
+      std::map<std::string, std::string> path_of;  // prefix -> the full path that has it
+      bool distinct = true;
+      for (const std::size_t i : members) {
+        const std::string full = prefix(i, deepest);
+        const auto [it, inserted] = path_of.emplace(prefix(i, depth), full);
+        distinct = distinct && (inserted || it->second == full);
+      }
+      if (distinct) break;
+    }
+    for (const std::size_t i : members) entries[i].name = prefix(i, depth) + name;
+  }
+  std::vector<std::string> names;
+  std::map<std::string, int> seen;
+  for (const Entry& e : entries) {
+    const int n = ++seen[e.name];
+    names.push_back(n > 1 ? e.name + "_" + std::to_string(n) : e.name);
+  }
+  return names;
+}
+
+// A CSV field: quoted when it holds a comma, a quote or a line break.
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (const char ch : text) quoted += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return quoted + "\"";
+}
+
+std::string csv_number(const nlohmann::json& value) {
+  if (value.is_null()) return "";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", value.get<double>());
+  return text;
+}
+
+// batch.csv: one row per image, in the order given.
+std::string batch_csv(const nlohmann::json& cases) {
+  std::string csv =
+      "image,output,status,volume_mm3,compute_seconds,load_seconds,wall_seconds,self_intersections,init_used,"
+      "registration,error\n";
+  for (const auto& c : cases) {
+    csv += csv_field(c["image"].get<std::string>()) + "," + csv_field(c["output"].get<std::string>()) + "," +
+           c["status"].get<std::string>() + "," + csv_number(c.value("volume_mm3", nlohmann::json())) + "," +
+           csv_number(c.value("compute_seconds", nlohmann::json())) + "," +
+           csv_number(c.value("load_seconds", nlohmann::json())) + "," + csv_number(c["wall_seconds"]) + "," +
+           (c.contains("self_intersections") ? std::to_string(c["self_intersections"].get<int>()) : std::string()) + "," +
+           csv_field(c.value("init_used", std::string())) + "," + csv_field(c.value("registration", std::string())) + "," +
+           csv_field(c.value("error", std::string())) + "\n";
+  }
+  return csv;
+}
+
+// Image paths from a list file: one per line; blank lines and lines starting with # skipped;
+// relative paths are relative to the list's folder.
+std::vector<std::string> read_image_list(const std::string& list) {
+  std::ifstream in(list);
+  if (!in) throw InputError("cannot read the image list '" + list + "'; check the path");
+  std::vector<std::string> images;
+  const std::filesystem::path base = std::filesystem::path(list).parent_path();
+  for (std::string line; std::getline(in, line);) {
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.pop_back();
+    const auto first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') continue;
+    const std::filesystem::path p = line.substr(first);
+    images.push_back((p.is_absolute() ? p : base / p).string());
+  }
+  return images;
+}
+
+}  // namespace
+
+void add_segment_batch_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "segment-batch", "Segment many volumes with one shape model, read once: a folder per image and a summary (batch.json, batch.csv)");
+  struct Args {
+    std::vector<std::string> images;
+    std::string model, output, list;
+    SnakeArgs snake;
+    bool json = false;
+  };
+  auto a = std::make_shared<Args>();
+  cmd->add_option("images", a->images, "Volumes to segment (.nii.gz .nrrd .mha ..., or DICOM folders)");
+  cmd->add_option("--list", a->list, "A text file of volumes to segment, one path per line (# comments; relative to the file)");
+  cmd->add_option("--model", a->model, "Shape model folder (made by 'mrsnake build-model')")->required();
+  cmd->add_option("-o,--output", a->output,
+                  "Output folder: DIR/NAME/ per image (as 'mrsnake segment' writes it), DIR/batch.json, DIR/batch.csv")
+      ->required();
+  a->snake.add_to(cmd);
+  cmd->add_flag("--json", a->json, "Print the summary (batch.json) on stdout");
+  cmd->footer(
+      "Example:\n"
+      "  mrsnake segment-batch --model heart.model -o study/seg study/mouse*/ct.nii.gz\n"
+      "Each image gets DIR/NAME/ (NAME: its file name without extensions, with its parent folder's name in\n"
+      "front when two images share a name), written as 'mrsnake segment' writes it. A failing image does\n"
+      "not stop the batch: batch.json and batch.csv (rewritten after every image) give each image's status,\n"
+      "error, segmented volume (mm3), times, self-intersections and initialization. Exit code 6 when some failed.");
+  cmd->callback([a] {
+    std::vector<std::string> images = a->images;
+    if (!a->list.empty()) {
+      const std::vector<std::string> listed = read_image_list(a->list);
+      images.insert(images.end(), listed.begin(), listed.end());
+    }
+    if (images.empty()) throw CLI::ValidationError("images", "give the volumes to segment, or --list FILE");
+    const SegmentOptions options = a->snake.options();
+    ensure_writable_directory(a->output);
+    const auto [model, model_seconds] = load_snake_model(a->model);
+    const std::vector<std::string> names = case_names(images);
+    const std::filesystem::path dir(a->output);
+    const auto t_batch = std::chrono::steady_clock::now();
+
+    nlohmann::json summary = {{"model", a->model}, {"model_load_seconds", model_seconds}, {"cases", nlohmann::json::array()}};
+    int failed = 0;
+    std::vector<double> compute;
+    for (std::size_t i = 0; i < images.size(); ++i) {
+      const auto t_case = std::chrono::steady_clock::now();
+      SegmentCase c;
+      c.image = images[i];
+      c.output = (dir / names[i]).string();
+      nlohmann::json row = {{"image", c.image}, {"output", c.output}};
+      const std::string position = "[" + std::to_string(i + 1) + "/" + std::to_string(images.size()) + "] ";
+      try {
+        const SegmentCaseOutcome outcome = segment_case(c, model, a->model, options, 0.0, terminal_progress());
+        const nlohmann::json& rep = outcome.report;
+        row["status"] = "ok";
+        row["volume_mm3"] = rep["volume_mm3"];
+        row["compute_seconds"] = rep["compute_seconds"];
+        row["load_seconds"] = rep["stage_seconds"]["load"];
+        row["self_intersections"] = rep["self_intersections"];
+        row["init_used"] = rep.value("init_used", std::string());
+        if (rep.contains("registration"))
+          row["registration"] = rep["registration"].value("accepted", false) ? "accepted" : "rejected";
+        compute.push_back(rep["compute_seconds"].get<double>());
+        char line[200];
+        std::snprintf(line, sizeof line, "%s%s: %.3f s of compute, volume %.1f mm3, %d self-intersections",
+                      position.c_str(), names[i].c_str(), rep["compute_seconds"].get<double>(),
+                      rep["volume_mm3"].get<double>(), rep["self_intersections"].get<int>());
+        info(line);
+      } catch (const Error& e) {
+        row["status"] = "failed";
+        row["error"] = e.what();
+        row["exit_code"] = static_cast<int>(e.code());
+      } catch (const std::bad_alloc&) {
+        row["status"] = "failed";
+        row["error"] = "out of memory";
+        row["exit_code"] = static_cast<int>(ExitCode::failed);
+      } catch (const std::exception& e) {  // a bug; the other images may still succeed
+        row["status"] = "failed";
+        row["error"] = std::string("internal error: ") + e.what();
+        row["exit_code"] = static_cast<int>(ExitCode::internal);
+      }
+      if (row["status"] == "failed") {
+        ++failed;
+        warn(position + names[i] + " failed: " + row["error"].get<std::string>());
+      }
+      row["wall_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_case).count();
+      summary["cases"].push_back(row);
+      summary["succeeded"] = static_cast<int>(i + 1) - failed;
+      summary["failed"] = failed;
+      summary["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_batch).count();
+      // After every image: an interrupted batch leaves the summary of what it did.
+      write_text_file_atomically((dir / "batch.json").string(), summary.dump(2) + "\n");
+      write_text_file_atomically((dir / "batch.csv").string(), batch_csv(summary["cases"]));
+    }
+    if (a->json) print_json(summary);
+    std::string line = "segmented " + std::to_string(images.size() - failed) + " of " + std::to_string(images.size()) +
+                       " images in " + std::to_string(summary["seconds"].get<double>()) + " s";
+    if (!compute.empty()) {
+      std::nth_element(compute.begin(), compute.begin() + compute.size() / 2, compute.end());
+      line += " (median compute " + std::to_string(compute[compute.size() / 2]) + " s)";
+    }
+    info(line + "; summary in " + (dir / "batch.csv").string());
+    if (failed > 0)
+      throw PartialFailure(std::to_string(failed) + " of " + std::to_string(images.size()) +
+                           " images failed; each is listed with its error in " + (dir / "batch.json").string());
   });
 }
 

@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   cli::add_remesh_command(app);
   cli::add_build_model_command(app);
   cli::add_segment_command(app);
+  cli::add_segment_batch_command(app);
   cli::refuse_non_finite_numbers(app);
 
   try {

@@ -16,6 +16,7 @@ enum class ExitCode : int {
   bad_input = 3,  ///< an input file is missing, corrupt, unsupported or of the wrong kind
   output = 4,     ///< an output could not be written
   failed = 5,     ///< the algorithm could not produce a valid result from valid input
+  some_failed = 6,  ///< a batch ran, but some of its items failed (each is listed with its error)
   interrupted = 130,
 };
 
@@ -53,6 +54,12 @@ class OutputError : public Error {
 class AlgorithmError : public Error {
  public:
   explicit AlgorithmError(const std::string& what) : Error(what, ExitCode::failed) {}
+};
+
+/// A batch ran to its end, but some items failed; the batch's summary lists them.
+class PartialFailure : public Error {
+ public:
+  explicit PartialFailure(const std::string& what) : Error(what, ExitCode::some_failed) {}
 };
 
 }  // namespace mrsnake

@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -259,6 +260,63 @@ TEST_F(Robustness, InterruptLeavesNoPartialOutput) {
     EXPECT_EQ(WEXITSTATUS(status), 128 + sig) << "it finished before the interrupt; make the job bigger";
     EXPECT_EQ(count_entries(out), 0) << "a partial output or temporary survived";
   }
+}
+
+TEST_F(Robustness, BatchGoesOnPastABadImageAndSummarizesEveryImage) {
+  // Three images, one of them corrupt, two of them named image.nii.gz; the third given in a list.
+  std::ofstream(path("bad.nii.gz"), std::ios::binary) << "this is not a NIfTI file at all";
+  std::ofstream(path("list.txt")) << "# one more\n\nref/image.nii.gz\n";
+  const std::string out = path("batch");
+  const auto r = run_mrsnake("segment-batch --model " + path("ellipsoid.model") + " -o " + out + " " +
+                             path("tgt/image.nii.gz") + " " + path("bad.nii.gz") + " --list " + path("list.txt"));
+  EXPECT_EQ(r.exit_code, 6) << r.output;
+  EXPECT_NE(r.output.find("mrsnake: error: 1 of 3 images failed; each is listed with its error in "), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("[2/3] bad failed: "), std::string::npos) << r.output;
+
+  const auto summary = nlohmann::json::parse(mrsnake::test::read_all(fs::path(out) / "batch.json"));
+  ASSERT_EQ(summary["cases"].size(), 3u);
+  EXPECT_EQ(summary["succeeded"], 2);
+  EXPECT_EQ(summary["failed"], 1);
+  const auto& bad = summary["cases"][1];
+  EXPECT_EQ(bad["status"], "failed");
+  EXPECT_EQ(bad["exit_code"], 3);
+  EXPECT_NE(bad["error"].get<std::string>().find("bad.nii.gz"), std::string::npos);
+  EXPECT_FALSE(fs::exists(fs::path(out) / "bad"));
+  // The two named image.nii.gz get their folders' names; each folder is what segment writes.
+  for (const auto& [index, name] : {std::pair<int, std::string>{0, "tgt_image"}, {2, "ref_image"}}) {
+    const auto& c = summary["cases"][index];
+    EXPECT_EQ(c["status"], "ok") << c.dump();
+    EXPECT_EQ(c["output"], (fs::path(out) / name).string());
+    EXPECT_EQ(c["self_intersections"], 0);
+    for (const char* file : {"surface.vtp", "labels.nii.gz", "report.json", "report.html", "levels/level_0.vtp"})
+      EXPECT_TRUE(fs::exists(fs::path(out) / name / file)) << name << "/" << file;
+  }
+  // The same labels as a single segment, and the volume they hold, near the truth's.
+  const auto single = run_mrsnake("-q segment --image " + path("tgt/image.nii.gz") + " --model " +
+                                  path("ellipsoid.model") + " -o " + path("single") + " --json");
+  ASSERT_EQ(single.exit_code, 0) << single.output;
+  const mrsnake::Volume batch_labels = mrsnake::read_volume(out + "/tgt_image/labels.nii.gz");
+  EXPECT_EQ(batch_labels.data, mrsnake::read_volume(path("single/labels.nii.gz")).data);
+  const mrsnake::Volume truth = mrsnake::read_volume(path("tgt/truth.nii.gz"));
+  const double voxel = truth.spacing[0] * truth.spacing[1] * truth.spacing[2];
+  const double truth_mm3 = voxel * static_cast<double>(std::count(truth.data.begin(), truth.data.end(), 1.0f));
+  const double volume = summary["cases"][0]["volume_mm3"].get<double>();
+  EXPECT_DOUBLE_EQ(volume, nlohmann::json::parse(single.output)["volume_mm3"].get<double>());
+  EXPECT_NEAR(volume / truth_mm3, 1.0, 0.05);
+  // batch.csv: a header and a row per image, the error quoted.
+  std::ifstream csv(fs::path(out) / "batch.csv");
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(csv, line);) lines.push_back(line);
+  ASSERT_EQ(lines.size(), 4u);
+  EXPECT_EQ(lines[0].rfind("image,output,status,volume_mm3,", 0), 0u) << lines[0];
+  EXPECT_NE(lines[2].find(",failed,"), std::string::npos) << lines[2];
+  EXPECT_NE(lines[1].find(",ok,"), std::string::npos) << lines[1];
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+
+  // Nothing to segment is a usage error.
+  EXPECT_EQ(run_mrsnake("segment-batch --model " + path("ellipsoid.model") + " -o " + path("batch-none")).exit_code, 2);
 }
 
 TEST_F(Robustness, TruncatedUncompressedImage) {
