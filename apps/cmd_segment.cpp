@@ -1,12 +1,22 @@
 // mrsnake segment: the multiresolution snake on a new volume (see snake/segment.h).
+#include <poll.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
+#include <thread>
 #include <vector>
 
 #include "apps/cli.h"
@@ -342,6 +352,136 @@ std::vector<std::string> read_image_list(const std::string& list) {
   return images;
 }
 
+// One image of a batch: its row of batch.json. The image's own failures are recorded in the
+// row, not thrown: the batch goes on.
+nlohmann::json batch_row(const std::string& image, const std::string& output, const SnakeModel& model,
+                         const std::string& model_path, const SegmentOptions& options, const ProgressFn& progress) {
+  const auto t_case = std::chrono::steady_clock::now();
+  nlohmann::json row = {{"image", image}, {"output", output}};
+  const auto failed = [&](const std::string& error, ExitCode code) {
+    row["status"] = "failed";
+    row["error"] = error;
+    row["exit_code"] = static_cast<int>(code);
+  };
+  try {
+    SegmentCase c;
+    c.image = image;
+    c.output = output;
+    const nlohmann::json rep = segment_case(c, model, model_path, options, 0.0, progress).report;
+    row["status"] = "ok";
+    row["volume_mm3"] = rep["volume_mm3"];
+    row["compute_seconds"] = rep["compute_seconds"];
+    row["load_seconds"] = rep["stage_seconds"]["load"];
+    row["self_intersections"] = rep["self_intersections"];
+    row["init_used"] = rep.value("init_used", std::string());
+    if (rep.contains("registration"))
+      row["registration"] = rep["registration"].value("accepted", false) ? "accepted" : "rejected";
+  } catch (const Error& e) {
+    failed(e.what(), e.code());
+  } catch (const std::bad_alloc&) {
+    failed("out of memory", ExitCode::failed);
+  } catch (const std::exception& e) {  // a bug; the other images may still succeed
+    failed(std::string("internal error: ") + e.what(), ExitCode::internal);
+  }
+  row["wall_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_case).count();
+  return row;
+}
+
+// Runs batch_row on every image in `jobs` worker processes (forked after the model is read;
+// each takes every jobs-th image), calling `done(index, row)` in this process as rows come
+// in. Processes and not threads: a segmentation forks to render its page, which a second
+// thread holding a lock would deadlock, and ITK's thread settings are global.
+// \pre jobs >= 2; this process runs no other thread.
+void run_batch_in_processes(int jobs, const std::vector<std::string>& images, const std::vector<std::string>& outputs,
+                            const SnakeModel& model, const std::string& model_path, const SegmentOptions& options,
+                            const std::function<void(std::size_t, nlohmann::json)>& done) {
+  struct Worker {
+    pid_t pid = -1;
+    int fd = -1;
+    std::string pending;
+  };
+  std::vector<Worker> workers;
+  std::vector<bool> reported(images.size(), false);
+  std::fflush(stdout);
+  std::fflush(stderr);
+  for (int w = 0; w < jobs && static_cast<std::size_t>(w) < images.size(); ++w) {
+    int fds[2];
+    if (pipe(fds) != 0) throw Error(std::string("cannot start a batch worker: pipe failed: ") + std::strerror(errno));
+    const pid_t pid = fork();
+    if (pid < 0) throw Error(std::string("cannot start a batch worker: fork failed: ") + std::strerror(errno));
+    if (pid == 0) {
+      close(fds[0]);
+      for (const Worker& other : workers) close(other.fd);
+      prctl(PR_SET_PDEATHSIG, SIGTERM);  // killed with the batch: its handler removes the temporaries
+      for (std::size_t i = static_cast<std::size_t>(w); i < images.size(); i += static_cast<std::size_t>(jobs)) {
+        const std::string line =
+            nlohmann::json{{"index", i}, {"row", batch_row(images[i], outputs[i], model, model_path, options, {})}}
+                .dump() +
+            "\n";
+        for (std::size_t sent = 0; sent < line.size();) {
+          const ssize_t n = write(fds[1], line.data() + sent, line.size() - sent);
+          if (n < 0 && errno == EINTR) continue;
+          if (n <= 0) _exit(1);
+          sent += static_cast<std::size_t>(n);
+        }
+      }
+      close(fds[1]);
+      _exit(0);  // no atexit handlers or static destructors of the parent's state
+    }
+    close(fds[1]);
+    workers.push_back({pid, fds[0], {}});
+  }
+  std::size_t open_pipes = workers.size();
+  while (open_pipes > 0) {
+    std::vector<pollfd> polled;
+    for (const Worker& worker : workers)
+      if (worker.fd >= 0) polled.push_back({worker.fd, POLLIN, 0});
+    if (poll(polled.data(), polled.size(), -1) < 0) {
+      if (errno == EINTR) continue;
+      throw Error(std::string("batch workers: poll failed: ") + std::strerror(errno));
+    }
+    for (Worker& worker : workers) {
+      if (worker.fd < 0) continue;
+      const auto it = std::find_if(polled.begin(), polled.end(), [&](const pollfd& p) { return p.fd == worker.fd; });
+      if (it == polled.end() || it->revents == 0) continue;
+      char buffer[65536];
+      const ssize_t n = read(worker.fd, buffer, sizeof buffer);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        close(worker.fd);
+        worker.fd = -1;
+        --open_pipes;
+        continue;
+      }
+      worker.pending.append(buffer, static_cast<std::size_t>(n));
+      for (std::size_t end; (end = worker.pending.find('\n')) != std::string::npos;) {
+        const nlohmann::json message = nlohmann::json::parse(worker.pending.substr(0, end));
+        worker.pending.erase(0, end + 1);
+        const auto index = message["index"].get<std::size_t>();
+        reported[index] = true;
+        done(index, message["row"]);
+      }
+    }
+  }
+  // A worker that died (a crash, a kill) leaves its remaining images unreported.
+  for (std::size_t w = 0; w < workers.size(); ++w) {
+    int status = 0;
+    while (waitpid(workers[w].pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    for (std::size_t i = w; i < images.size(); i += workers.size())
+      if (!reported[i])
+        done(i, {{"image", images[i]},
+                 {"output", outputs[i]},
+                 {"status", "failed"},
+                 {"error", "its batch worker stopped (" +
+                               (WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status))
+                                                    : "exit code " + std::to_string(WEXITSTATUS(status))) +
+                               ") before segmenting it"},
+                 {"exit_code", static_cast<int>(ExitCode::internal)},
+                 {"wall_seconds", 0.0}});
+  }
+}
+
 }  // namespace
 
 void add_segment_batch_command(CLI::App& app) {
@@ -351,6 +491,7 @@ void add_segment_batch_command(CLI::App& app) {
     std::vector<std::string> images;
     std::string model, output, list;
     SnakeArgs snake;
+    int jobs = 1;
     bool json = false;
   };
   auto a = std::make_shared<Args>();
@@ -361,6 +502,10 @@ void add_segment_batch_command(CLI::App& app) {
                   "Output folder: DIR/NAME/ per image (as 'mrsnake segment' writes it), DIR/batch.json, DIR/batch.csv")
       ->required();
   a->snake.add_to(cmd);
+  cmd->add_option("--jobs", a->jobs,
+                  "Images segmented at once, each in a process of its own on one core (default 1; the cores: " +
+                      std::to_string(std::max(1u, std::thread::hardware_concurrency())) + ")")
+      ->check(CLI::Range(1, 256));
   cmd->add_flag("--json", a->json, "Print the summary (batch.json) on stdout");
   cmd->footer(
       "Example:\n"
@@ -379,68 +524,54 @@ void add_segment_batch_command(CLI::App& app) {
     const SegmentOptions options = a->snake.options();
     ensure_writable_directory(a->output);
     const auto [model, model_seconds] = load_snake_model(a->model);
-    const std::vector<std::string> names = case_names(images);
     const std::filesystem::path dir(a->output);
+    std::vector<std::string> outputs;
+    for (const std::string& name : case_names(images)) outputs.push_back((dir / name).string());
     const auto t_batch = std::chrono::steady_clock::now();
 
-    nlohmann::json summary = {{"model", a->model}, {"model_load_seconds", model_seconds}, {"cases", nlohmann::json::array()}};
-    int failed = 0;
-    std::vector<double> compute;
-    for (std::size_t i = 0; i < images.size(); ++i) {
-      const auto t_case = std::chrono::steady_clock::now();
-      SegmentCase c;
-      c.image = images[i];
-      c.output = (dir / names[i]).string();
-      nlohmann::json row = {{"image", c.image}, {"output", c.output}};
-      const std::string position = "[" + std::to_string(i + 1) + "/" + std::to_string(images.size()) + "] ";
-      try {
-        const SegmentCaseOutcome outcome = segment_case(c, model, a->model, options, 0.0, terminal_progress());
-        const nlohmann::json& rep = outcome.report;
-        row["status"] = "ok";
-        row["volume_mm3"] = rep["volume_mm3"];
-        row["compute_seconds"] = rep["compute_seconds"];
-        row["load_seconds"] = rep["stage_seconds"]["load"];
-        row["self_intersections"] = rep["self_intersections"];
-        row["init_used"] = rep.value("init_used", std::string());
-        if (rep.contains("registration"))
-          row["registration"] = rep["registration"].value("accepted", false) ? "accepted" : "rejected";
-        compute.push_back(rep["compute_seconds"].get<double>());
+    std::vector<nlohmann::json> rows(images.size());
+    int finished = 0, failed = 0;
+    nlohmann::json summary;
+    // Each finished image: a line on the terminal, and the summary rewritten (an interrupted
+    // batch leaves the record of what it did).
+    const auto done = [&](std::size_t i, nlohmann::json row) {
+      ++finished;
+      const std::string position = "[" + std::to_string(finished) + "/" + std::to_string(images.size()) + "] ";
+      const std::string name = std::filesystem::path(outputs[i]).filename().string();
+      if (row["status"] == "ok") {
         char line[200];
         std::snprintf(line, sizeof line, "%s%s: %.3f s of compute, volume %.1f mm3, %d self-intersections",
-                      position.c_str(), names[i].c_str(), rep["compute_seconds"].get<double>(),
-                      rep["volume_mm3"].get<double>(), rep["self_intersections"].get<int>());
+                      position.c_str(), name.c_str(), row["compute_seconds"].get<double>(),
+                      row["volume_mm3"].get<double>(), row["self_intersections"].get<int>());
         info(line);
-      } catch (const Error& e) {
-        row["status"] = "failed";
-        row["error"] = e.what();
-        row["exit_code"] = static_cast<int>(e.code());
-      } catch (const std::bad_alloc&) {
-        row["status"] = "failed";
-        row["error"] = "out of memory";
-        row["exit_code"] = static_cast<int>(ExitCode::failed);
-      } catch (const std::exception& e) {  // a bug; the other images may still succeed
-        row["status"] = "failed";
-        row["error"] = std::string("internal error: ") + e.what();
-        row["exit_code"] = static_cast<int>(ExitCode::internal);
-      }
-      if (row["status"] == "failed") {
+      } else {
         ++failed;
-        warn(position + names[i] + " failed: " + row["error"].get<std::string>());
+        warn(position + name + " failed: " + row["error"].get<std::string>());
       }
-      row["wall_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_case).count();
-      summary["cases"].push_back(row);
-      summary["succeeded"] = static_cast<int>(i + 1) - failed;
+      rows[i] = std::move(row);
+      summary = {{"model", a->model}, {"model_load_seconds", model_seconds}, {"jobs", a->jobs}, {"cases", nlohmann::json::array()}};
+      for (const nlohmann::json& r : rows)
+        if (!r.is_null()) summary["cases"].push_back(r);
+      summary["succeeded"] = finished - failed;
       summary["failed"] = failed;
       summary["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_batch).count();
-      // After every image: an interrupted batch leaves the summary of what it did.
       write_text_file_atomically((dir / "batch.json").string(), summary.dump(2) + "\n");
       write_text_file_atomically((dir / "batch.csv").string(), batch_csv(summary["cases"]));
+    };
+    if (a->jobs > 1 && images.size() > 1) {
+      run_batch_in_processes(a->jobs, images, outputs, model, a->model, options, done);
+    } else {
+      for (std::size_t i = 0; i < images.size(); ++i)
+        done(i, batch_row(images[i], outputs[i], model, a->model, options, terminal_progress()));
     }
     if (a->json) print_json(summary);
-    std::string line = "segmented " + std::to_string(images.size() - failed) + " of " + std::to_string(images.size()) +
+    std::vector<double> compute;
+    for (const nlohmann::json& r : rows)
+      if (r.contains("compute_seconds")) compute.push_back(r["compute_seconds"].get<double>());
+    std::string line = "segmented " + std::to_string(finished - failed) + " of " + std::to_string(images.size()) +
                        " images in " + std::to_string(summary["seconds"].get<double>()) + " s";
     if (!compute.empty()) {
-      std::nth_element(compute.begin(), compute.begin() + compute.size() / 2, compute.end());
+      std::nth_element(compute.begin(), compute.begin() + static_cast<long>(compute.size() / 2), compute.end());
       line += " (median compute " + std::to_string(compute[compute.size() / 2]) + " s)";
     }
     info(line + "; summary in " + (dir / "batch.csv").string());

@@ -315,8 +315,68 @@ TEST_F(Robustness, BatchGoesOnPastABadImageAndSummarizesEveryImage) {
   for (const auto& e : fs::directory_iterator(out))
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
 
+  // Two worker processes: the same rows (in the order given) and the same labels.
+  const auto two = run_mrsnake("-q segment-batch --jobs 2 --model " + path("ellipsoid.model") + " -o " +
+                               path("batch2") + " " + path("tgt/image.nii.gz") + " " + path("bad.nii.gz") + " --list " +
+                               path("list.txt"));
+  EXPECT_EQ(two.exit_code, 6) << two.output;
+  const auto summary2 = nlohmann::json::parse(mrsnake::test::read_all(fs::path(path("batch2")) / "batch.json"));
+  ASSERT_EQ(summary2["cases"].size(), 3u);
+  EXPECT_EQ(summary2["jobs"], 2);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(summary2["cases"][i]["status"], summary["cases"][i]["status"]) << i;
+    EXPECT_EQ(summary2["cases"][i].value("volume_mm3", -1.0), summary["cases"][i].value("volume_mm3", -1.0)) << i;
+  }
+  EXPECT_EQ(mrsnake::read_volume(path("batch2/ref_image/labels.nii.gz")).data,
+            mrsnake::read_volume(out + "/ref_image/labels.nii.gz").data);
+
   // Nothing to segment is a usage error.
   EXPECT_EQ(run_mrsnake("segment-batch --model " + path("ellipsoid.model") + " -o " + path("batch-none")).exit_code, 2);
+}
+
+TEST_F(Robustness, InterruptedBatchLeavesNoPartialOutputNorWorkers) {
+  // segment-batch --jobs 2 on 80 images (about 0.1 s each), killed mid-way (SIGTERM to the batch alone): its
+  // workers must die with it, each removing its own temporaries.
+  const fs::path out = *dir_ / "batch-interrupted";
+  {
+    std::ofstream list(path("eighty.txt"));
+    for (int i = 0; i < 80; ++i) list << path("tgt/image.nii.gz") << "\n";
+  }
+  const char* bin = std::getenv("MRSNAKE_BIN");
+  ASSERT_NE(bin, nullptr);
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    execl(bin, bin, "-q", "segment-batch", "--jobs", "2", "--model", path("ellipsoid.model").c_str(), "-o", out.c_str(),
+          "--list", path("eighty.txt").c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Killed once the first image is done (batch.json written): the workers are then inside
+  // their next images, whatever the speed of the machine (or of a sanitizer build).
+  for (int wait = 0; wait < 3000 && !fs::exists(out / "batch.json"); ++wait) usleep(20000);
+  kill(child, SIGTERM);
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by a signal instead of exiting cleanly";
+  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM) << "it finished before the interrupt; make the batch bigger";
+  // The workers: gone within a moment (their command line names the output folder).
+  const auto workers_alive = [&] {
+    int alive = 0;
+    for (const auto& e : fs::directory_iterator("/proc")) {
+      std::ifstream cmdline(e.path() / "cmdline", std::ios::binary);
+      const std::string text((std::istreambuf_iterator<char>(cmdline)), std::istreambuf_iterator<char>());
+      alive += text.find(out.string()) != std::string::npos;
+    }
+    return alive;
+  };
+  for (int wait = 0; wait < 50 && workers_alive() > 0; ++wait) usleep(100000);
+  EXPECT_EQ(workers_alive(), 0);
+  // Some images were done before the kill (so the workers ran), and their record is whole.
+  const auto summary = nlohmann::json::parse(mrsnake::test::read_all(out / "batch.json"));
+  EXPECT_GE(summary["cases"].size(), 1u);
+  EXPECT_LT(summary["cases"].size(), 80u);
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_EQ(e.path().filename().string().rfind(".tmp", 0), std::string::npos) << "a temporary survived: " << e.path();
 }
 
 TEST_F(Robustness, TruncatedUncompressedImage) {
