@@ -3,6 +3,7 @@
 
 #include "apps/cli.h"
 #include "mesh/image_io.h"
+#include "mesh/label_repair.h"
 #include "mesh/marching_cubes.h"
 #include "mesh/mesh_io.h"
 #include "mesh/topology.h"
@@ -16,6 +17,7 @@ void add_mc_command(CLI::App& app) {
     int label = 1;
     int smooth = 0;
     int close_tunnels = 0;
+    int component = 0;
     double spacing = 0;
     bool json = false;
   };
@@ -28,6 +30,10 @@ void add_mc_command(CLI::App& app) {
   cmd->add_option("--close-tunnels", a->close_tunnels,
                   "If the surface is not genus 0, close the label with radii up to this many voxels until it is")
       ->check(CLI::Range(0, 20));
+  cmd->add_option("--component", a->component,
+                  "Only the label's K-th largest connected part (1 = the largest; as 'build-model --component'); "
+                  "0 = all of it, of which the largest surface is kept")
+      ->check(CLI::Range(0, 1000));
   cmd->add_option("--spacing", a->spacing,
                   "Extract the 0.5 isosurface of the label's Gaussian-smoothed occupancy resampled to this isotropic "
                   "spacing in mm (as 'mrsnake build-model --mc-spacing'); 0 = the voxels' own surface (default)")
@@ -39,7 +45,8 @@ void add_mc_command(CLI::App& app) {
   cmd->callback([a] {
     const auto progress = terminal_progress();
     report(progress, "reading " + a->labels, 0.0);
-    const Volume labels = read_volume(a->labels);
+    const Volume labels =
+        a->component > 0 ? keep_label_part(read_volume(a->labels), a->label, a->component) : read_volume(a->labels);
     LabelSurfaceOptions options;
     options.smoothing_iterations = a->smooth;
     options.max_closing_radius = a->close_tunnels;

@@ -286,6 +286,29 @@ TEST(McCommand, WritesAMeshAndRefusesAnAbsentLabel) {
   EXPECT_EQ(r.exit_code, 3) << r.output;
 }
 
+TEST(McCommand, ComponentExtractsOnePartOfTheLabel) {
+  // Label 4 on two balls of radius 6 and 4: --component picks one, the rest is background.
+  const auto dir = test::scratch_dir("mc-cli-parts");
+  std::size_t big = 0, small = 0;
+  Volume labels = voxelized_ball(grid(32, {1, 1, 1}), {8, 16, 16}, 6.0, 4, big);
+  const Volume other = voxelized_ball(grid(32, {1, 1, 1}), {24, 16, 16}, 4.0, 4, small);
+  for (std::size_t i = 0; i < labels.num_voxels(); ++i) labels.data[i] += other.data[i];
+  const std::string img = (dir / "labels.nii.gz").string();
+  write_volume(img, labels, VoxelType::uint8);
+  const auto centre_x = [](const TriMesh& m) { return m.V.col(0).mean(); };
+  for (const int part : {1, 2}) {
+    const std::string out = (dir / ("part" + std::to_string(part) + ".vtp")).string();
+    const auto r = test::run_mrsnake("mc --labels " + img + " --label 4 --component " + std::to_string(part) + " -o " + out);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(r.output.find("connected surfaces"), std::string::npos) << r.output;  // nothing dropped
+    EXPECT_NEAR(centre_x(read_mesh(out)), part == 1 ? 8.0 : 24.0, 0.5);
+  }
+  const auto r = test::run_mrsnake("mc --labels " + img + " --label 4 --component 3 -o " + (dir / "p3.vtp").string());
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("label 4 has 2 connected parts, so there is no part 3"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "p3.vtp"));
+}
+
 TEST(McCommand, LiverIsOneClosedGenusZeroSurface) {
   MRSNAKE_REQUIRE_DATA(liver, "volumes/liver-labels.nii.gz");
   const Volume labels = read_volume(liver);
