@@ -9,6 +9,7 @@
 #include <iostream>
 #include <map>
 
+#include "mesh/json_text.h"
 #include "remesh/parameterization.h"
 
 namespace mrsnake::cli {
@@ -24,7 +25,7 @@ void info(const std::string& message) {
 
 void warn(const std::string& message) { std::cerr << "mrsnake: warning: " << message << '\n'; }
 
-void print_json(const nlohmann::json& j) { std::cout << j.dump(2) << std::endl; }
+void print_json(const nlohmann::json& j) { std::cout << json_text(j, 2) << std::endl; }
 
 void add_sphere_map_option(CLI::App& command, SphereMap& map) {
   command

@@ -8,6 +8,7 @@
 #include "apps/cli.h"
 #include "apps/report/remesh_page.h"
 #include "mesh/atomic_file.h"
+#include "mesh/json_text.h"
 #include "mesh/mesh_io.h"
 #include "remesh/remesh.h"
 
@@ -119,7 +120,7 @@ void add_remesh_command(CLI::App& app) {
     const std::filesystem::path dir(out.temp_path());
     for (int j = 0; j <= result.connectivity.levels(); ++j)
       write_mesh((dir / ("level_" + std::to_string(j) + ".vtp")).string(), result.mesh(j));
-    write_text_file_atomically((dir / "report.json").string(), report.dump(2) + "\n");
+    write_text_file_atomically((dir / "report.json").string(), json_text(report, 2) + "\n");
     mrsnake::reports::RemeshPageOptions page;
     page.title = "mrsnake remesh " + std::filesystem::path(args->mesh).filename().string();
     page.input = &input;

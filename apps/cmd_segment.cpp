@@ -16,6 +16,7 @@
 #include <functional>
 #include <iostream>
 #include <map>
+#include <set>
 #include <thread>
 #include <vector>
 
@@ -25,6 +26,7 @@
 #include "mesh/distance.h"
 #include "mesh/errors.h"
 #include "mesh/image_io.h"
+#include "mesh/json_text.h"
 #include "mesh/mesh_io.h"
 #include "mesh/parallel.h"
 #include "snake/evaluate.h"
@@ -79,6 +81,16 @@ struct SegmentCaseOutcome {
 
 SegmentCaseOutcome segment_case(const SegmentCase& c, const SnakeModel& model, const std::string& model_path,
                                 const SegmentOptions& options, double model_load_seconds, const ProgressFn& progress) {
+  // The folder is replaced at the end: only an earlier result may be, never other data (an
+  // output named after a DICOM input folder would be that folder).
+  if (std::error_code ec; std::filesystem::exists(c.output, ec)) {
+    const std::filesystem::path out(c.output);
+    const bool earlier_result = std::filesystem::is_directory(out, ec) &&
+                                (std::filesystem::is_empty(out, ec) || std::filesystem::exists(out / "report.json", ec));
+    if (!earlier_result)
+      throw OutputError("'" + c.output + "' exists and is not an output of mrsnake segment (no report.json); choose " +
+                        "another output folder, or move it away");
+  }
   const auto t_load = std::chrono::steady_clock::now();
   report(progress, "load", 0.0);
   const Volume image = read_volume(c.image);
@@ -142,7 +154,7 @@ SegmentCaseOutcome segment_case(const SegmentCase& c, const SnakeModel& model, c
     write_mesh((dir / "surface.vtp").string(), result.surface);
     for (const LevelOutcome& l : result.levels)
       write_mesh((dir / "levels" / ("level_" + std::to_string(l.level) + ".vtp")).string(), l.surface);
-    write_text_file_atomically((dir / "report.json").string(), rep.dump(2) + "\n");
+    write_text_file_atomically((dir / "report.json").string(), json_text(rep, 2) + "\n");
   };
   // The compressed labels are written on the other core, beside the meshes.
   run_both_in_parallel(write_meshes, [&] { write_volume((dir / "labels.nii.gz").string(), labels, VoxelType::uint8); });
@@ -248,8 +260,9 @@ void add_segment_command(CLI::App& app) {
 namespace {
 
 // An output folder name per image: the file name without its extensions (a DICOM folder's
-// own name). Names that collide take as many of their parent folders' names in front as
-// tell them apart (study/mouse01/ct.nii.gz: mouse01_ct), then a number.
+// own name), without leading dots. Names that collide take as many of their parent folders'
+// names in front as tell them apart (study/mouse01/ct.nii.gz: mouse01_ct), then a number
+// that no other name has.
 std::vector<std::string> case_names(const std::vector<std::string>& images) {
   struct Entry {
     std::vector<std::string> parents;  // nearest first
@@ -261,8 +274,12 @@ std::vector<std::string> case_names(const std::vector<std::string>& images) {
     if (p.filename().empty()) p = p.parent_path();  // a folder given with a trailing slash
     Entry e;
     e.name = p.filename().string();
-    if (e.name.size() > 3 && e.name.compare(e.name.size() - 3, 3, ".gz") == 0) e.name.resize(e.name.size() - 3);
-    if (const auto dot = e.name.rfind('.'); dot != std::string::npos && dot > 0) e.name.resize(dot);
+    if (!std::filesystem::is_directory(p)) {  // a DICOM folder's name (a UID, 1.2.840...) is kept whole
+      if (e.name.size() > 3 && e.name.compare(e.name.size() - 3, 3, ".gz") == 0) e.name.resize(e.name.size() - 3);
+      if (const auto dot = e.name.rfind('.'); dot != std::string::npos && dot > 0) e.name.resize(dot);
+    }
+    // No hidden names: ".", ".." and the temporaries' ".tmp-" would not be folders of their own.
+    e.name.erase(0, e.name.find_first_not_of('.'));
     if (e.name.empty()) e.name = "image";
     for (std::filesystem::path q = p.parent_path(); !q.filename().empty(); q = q.parent_path())
       e.parents.push_back(q.filename().string());
@@ -281,6 +298,9 @@ std::vector<std::string> case_names(const std::vector<std::string>& images) {
     };
     std::size_t deepest = 0;
     for (const std::size_t i : members) deepest = std::max(deepest, entries[i].parents.size());
+    std::set<std::string> paths;
+    for (const std::size_t i : members) paths.insert(prefix(i, deepest));
+    if (paths.size() < 2) continue;  // one image given several times
     std::size_t depth = 1;
     for (; depth < deepest; ++depth) {
       std::map<std::string, std::string> path_of;  // prefix -> the full path that has it
@@ -294,11 +314,14 @@ std::vector<std::string> case_names(const std::vector<std::string>& images) {
     }
     for (const std::size_t i : members) entries[i].name = prefix(i, depth) + name;
   }
+  // Numbered against every name taken so far, the summary's files included.
+  std::set<std::string> taken{"batch.json", "batch.csv"};
   std::vector<std::string> names;
-  std::map<std::string, int> seen;
   for (const Entry& e : entries) {
-    const int n = ++seen[e.name];
-    names.push_back(n > 1 ? e.name + "_" + std::to_string(n) : e.name);
+    std::string name = e.name;
+    for (int n = 2; taken.count(name) > 0; ++n) name = e.name + "_" + std::to_string(n);
+    taken.insert(name);
+    names.push_back(name);
   }
   return names;
 }
@@ -339,7 +362,8 @@ std::string batch_csv(const nlohmann::json& cases) {
 // relative paths are relative to the list's folder.
 std::vector<std::string> read_image_list(const std::string& list) {
   std::ifstream in(list);
-  if (!in) throw InputError("cannot read the image list '" + list + "'; check the path");
+  if (!in || !std::filesystem::is_regular_file(list))
+    throw InputError("cannot read the image list '" + list + "' (a text file, one path per line); check the path");
   std::vector<std::string> images;
   const std::filesystem::path base = std::filesystem::path(list).parent_path();
   for (std::string line; std::getline(in, line);) {
@@ -407,26 +431,34 @@ void run_batch_in_processes(int jobs, const std::vector<std::string>& images, co
   for (int w = 0; w < jobs && static_cast<std::size_t>(w) < images.size(); ++w) {
     int fds[2];
     if (pipe(fds) != 0) throw Error(std::string("cannot start a batch worker: pipe failed: ") + std::strerror(errno));
+    const pid_t batch = getpid();
     const pid_t pid = fork();
     if (pid < 0) throw Error(std::string("cannot start a batch worker: fork failed: ") + std::strerror(errno));
     if (pid == 0) {
-      close(fds[0]);
-      for (const Worker& other : workers) close(other.fd);
-      prctl(PR_SET_PDEATHSIG, SIGTERM);  // killed with the batch: its handler removes the temporaries
-      for (std::size_t i = static_cast<std::size_t>(w); i < images.size(); i += static_cast<std::size_t>(jobs)) {
-        const std::string line =
-            nlohmann::json{{"index", i}, {"row", batch_row(images[i], outputs[i], model, model_path, options, {})}}
-                .dump() +
-            "\n";
-        for (std::size_t sent = 0; sent < line.size();) {
-          const ssize_t n = write(fds[1], line.data() + sent, line.size() - sent);
-          if (n < 0 && errno == EINTR) continue;
-          if (n <= 0) _exit(1);
-          sent += static_cast<std::size_t>(n);
+      // Nothing leaves this branch: the worker ends with _exit, without the atexit handlers or
+      // static destructors of the batch's state.
+      try {
+        close(fds[0]);
+        for (const Worker& other : workers) close(other.fd);
+        // Killed with the batch (its handler removes the temporaries), also if the batch died
+        // before this line.
+        prctl(PR_SET_PDEATHSIG, SIGTERM);
+        if (getppid() != batch) _exit(1);
+        for (std::size_t i = static_cast<std::size_t>(w); i < images.size(); i += static_cast<std::size_t>(jobs)) {
+          const std::string line =
+              json_text({{"index", i}, {"row", batch_row(images[i], outputs[i], model, model_path, options, {})}}) + "\n";
+          for (std::size_t sent = 0; sent < line.size();) {
+            const ssize_t n = write(fds[1], line.data() + sent, line.size() - sent);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) _exit(1);
+            sent += static_cast<std::size_t>(n);
+          }
         }
+        close(fds[1]);
+      } catch (...) {
+        _exit(1);
       }
-      close(fds[1]);
-      _exit(0);  // no atexit handlers or static destructors of the parent's state
+      _exit(0);
     }
     close(fds[1]);
     workers.push_back({pid, fds[0], {}});
@@ -503,7 +535,7 @@ void add_segment_batch_command(CLI::App& app) {
       ->required();
   a->snake.add_to(cmd);
   cmd->add_option("--jobs", a->jobs,
-                  "Images segmented at once, each in a process of its own on one core (default 1; the cores: " +
+                  "Images segmented at once, each in a worker process of its own (default 1; the cores: " +
                       std::to_string(std::max(1u, std::thread::hardware_concurrency())) + ")")
       ->check(CLI::Range(1, 256));
   cmd->add_flag("--json", a->json, "Print the summary (batch.json) on stdout");
@@ -522,8 +554,8 @@ void add_segment_batch_command(CLI::App& app) {
     }
     if (images.empty()) throw CLI::ValidationError("images", "give the volumes to segment, or --list FILE");
     const SegmentOptions options = a->snake.options();
-    ensure_writable_directory(a->output);
     const auto [model, model_seconds] = load_snake_model(a->model);
+    ensure_writable_directory(a->output);
     const std::filesystem::path dir(a->output);
     std::vector<std::string> outputs;
     for (const std::string& name : case_names(images)) outputs.push_back((dir / name).string());
@@ -555,7 +587,7 @@ void add_segment_batch_command(CLI::App& app) {
       summary["succeeded"] = finished - failed;
       summary["failed"] = failed;
       summary["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_batch).count();
-      write_text_file_atomically((dir / "batch.json").string(), summary.dump(2) + "\n");
+      write_text_file_atomically((dir / "batch.json").string(), json_text(summary, 2) + "\n");
       write_text_file_atomically((dir / "batch.csv").string(), batch_csv(summary["cases"]));
     };
     if (a->jobs > 1 && images.size() > 1) {

@@ -8,6 +8,7 @@
 #include "mesh/atomic_file.h"
 #include "mesh/errors.h"
 #include "mesh/image_io.h"
+#include "mesh/json_text.h"
 #include "mesh/label_repair.h"
 #include "mesh/mesh_io.h"
 #include "mesh/topology.h"
@@ -177,7 +178,7 @@ void add_synth_command(CLI::App& app) {
     if (!topology.is_closed_genus0())
       warn("the truth surface is " + topology.describe() + " (the label has several parts or holes)");
     nlohmann::json pj = params;
-    write_text_file_atomically(params_path, pj.dump(2) + "\n");
+    write_text_file_atomically(params_path, json_text(pj, 2) + "\n");
 
     std::size_t object_voxels = 0;
     for (float v : r.truth.data) object_voxels += v == kTruthLabel;

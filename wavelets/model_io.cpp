@@ -11,6 +11,7 @@
 
 #include "mesh/atomic_file.h"
 #include "mesh/errors.h"
+#include "mesh/json_text.h"
 #include "mesh/mesh_io.h"
 
 namespace fs = std::filesystem;
@@ -200,7 +201,7 @@ nlohmann::json file_entry(const fs::path& dir, const std::string& name) {
 
 std::string manifest_checksum(nlohmann::json manifest) {
   manifest.erase("manifest_fnv1a64");
-  const std::string text = manifest.dump();
+  const std::string text = json_text(manifest);
   return hex64(fnv1a64(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
 }
 
@@ -329,7 +330,7 @@ void save_model(const std::string& folder, const ShapeModel& model, const Progre
   m["sections"] = sections;
   m["manifest_fnv1a64"] = manifest_checksum(m);
   write_bytes(temp / kManifest, [&] {
-    const std::string text = m.dump(2) + "\n";
+    const std::string text = json_text(m, 2) + "\n";
     return std::vector<std::uint8_t>(text.begin(), text.end());
   }());
   if (write_extras) write_extras(temp.string());

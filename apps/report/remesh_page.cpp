@@ -11,6 +11,7 @@
 #include "apps/report/render.h"
 #include "mesh/atomic_file.h"
 #include "mesh/distance.h"
+#include "mesh/json_text.h"
 #include "mesh/quality.h"
 
 namespace mrsnake::reports {
@@ -37,7 +38,7 @@ std::string setting(const nlohmann::json& v) {
     std::snprintf(buf, sizeof buf, "%.4g", v.get<double>());
     return buf;
   }
-  return v.dump();
+  return json_text(v);
 }
 
 /// Points measured per mesh for the page's distances: a 179k-face marching-cubes input has

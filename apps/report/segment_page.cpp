@@ -11,6 +11,7 @@
 #include "apps/report/render.h"
 #include "apps/report/slices.h"
 #include "mesh/atomic_file.h"
+#include "mesh/json_text.h"
 #include "mesh/marching_cubes.h"
 
 namespace mrsnake::reports {
@@ -35,7 +36,7 @@ std::string text(const nlohmann::json& v, int digits = 4) {
     for (const auto& e : v) out += (out.empty() ? "" : ", ") + text(e, digits);
     return out;
   }
-  return v.dump();
+  return json_text(v);
 }
 
 template <class Make>

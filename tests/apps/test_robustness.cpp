@@ -11,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <set>
 
 #include <nlohmann/json.hpp>
 #include <zlib.h>
@@ -332,6 +333,50 @@ TEST_F(Robustness, BatchGoesOnPastABadImageAndSummarizesEveryImage) {
 
   // Nothing to segment is a usage error.
   EXPECT_EQ(run_mrsnake("segment-batch --model " + path("ellipsoid.model") + " -o " + path("batch-none")).exit_code, 2);
+}
+
+TEST_F(Robustness, BatchNamesAreDistinctAndNeverReplaceOtherData) {
+  // Copies of one image under names that collide, that are the summary's own, that are
+  // hidden, that are not UTF-8 (byte 0xFF), and one named like a folder of other data in -o.
+  const fs::path in = *dir_ / "names";
+  fs::create_directories(in / "d");
+  const std::vector<std::string> files{"x.nii.gz",   "d/x_2.nii.gz", "batch.json.nii.gz", "..nii.gz",
+                                       "bad\xff.nii.gz", "precious.nii.gz"};
+  for (const std::string& f : files) fs::copy_file(path("tgt/image.nii.gz"), in / f);
+  const fs::path out = *dir_ / "names-out";
+  fs::create_directories(out / "precious");
+  std::ofstream(out / "precious" / "notes.txt") << "not mrsnake's";
+  std::string args = "-q segment-batch --jobs 2 --model " + path("ellipsoid.model") + " -o " + out.string();
+  for (const std::string& f : files) args += " '" + (in / f).string() + "'";
+  args += " '" + (in / "x.nii.gz").string() + "'";  // the same image twice
+  const auto r = run_mrsnake(args);
+  EXPECT_EQ(r.exit_code, 6) << r.output;
+  const auto summary = nlohmann::json::parse(mrsnake::test::read_all(out / "batch.json"));
+  ASSERT_EQ(summary["cases"].size(), files.size() + 1);
+  std::set<std::string> outputs;
+  for (const auto& c : summary["cases"]) {
+    const std::string name = fs::path(c["output"].get<std::string>()).filename().string();
+    EXPECT_TRUE(outputs.insert(name).second) << "two images share " << name;
+    EXPECT_NE(name.front(), '.') << name;
+    EXPECT_TRUE(name != "batch.json" && name != "batch.csv") << name;
+    if (name == "precious") {
+      EXPECT_EQ(c["status"], "failed");
+      EXPECT_NE(c["error"].get<std::string>().find("exists and is not an output of mrsnake segment"), std::string::npos);
+    } else {
+      EXPECT_EQ(c["status"], "ok") << name << ": " << c.dump();
+    }
+  }
+  EXPECT_TRUE(fs::is_regular_file(out / "batch.json"));
+  EXPECT_TRUE(fs::exists(out / "precious" / "notes.txt")) << "another program's folder was replaced";
+  // The single command refuses such a folder too, and replaces an earlier result.
+  const auto single = run_mrsnake("segment --image " + path("tgt/image.nii.gz") + " --model " + path("ellipsoid.model") +
+                                  " -o " + (out / "precious").string());
+  expect_one_line_error(single, 4, "exists and is not an output of mrsnake segment");
+  EXPECT_TRUE(fs::exists(out / "precious" / "notes.txt"));
+  EXPECT_EQ(run_mrsnake("-q segment --image " + path("tgt/image.nii.gz") + " --model " + path("ellipsoid.model") +
+                        " -o " + (out / "x").string())
+                .exit_code,
+            0);
 }
 
 TEST_F(Robustness, InterruptedBatchLeavesNoPartialOutputNorWorkers) {
