@@ -16,8 +16,12 @@
 
 namespace mrsnake {
 
-Volume close_label(const Volume& labels, int label, int radius_voxels) {
-  using Mask = itk::Image<unsigned char, 3>;
+namespace {
+
+using Mask = itk::Image<unsigned char, 3>;
+
+// 1 on the voxels of `label`, 0 elsewhere, on the labels' index grid.
+Mask::Pointer label_mask_image(const Volume& labels, int label) {
   auto mask = Mask::New();
   Mask::RegionType region;
   for (int d = 0; d < 3; ++d) region.SetSize(d, labels.size[d]);
@@ -26,6 +30,13 @@ Volume close_label(const Volume& labels, int label, int radius_voxels) {
   const auto target = static_cast<float>(label);
   unsigned char* m = mask->GetBufferPointer();
   for (std::size_t i = 0; i < labels.num_voxels(); ++i) m[i] = labels.data[i] == target ? 1 : 0;
+  return mask;
+}
+
+}  // namespace
+
+Volume close_label(const Volume& labels, int label, int radius_voxels) {
+  const Mask::Pointer mask = label_mask_image(labels, label);
 
   Mask::Pointer result = mask;
   if (radius_voxels > 0) {
@@ -64,16 +75,9 @@ Volume close_label(const Volume& labels, int label, int radius_voxels) {
 }
 
 Volume keep_label_part(const Volume& labels, int label, int rank) {
-  using Mask = itk::Image<unsigned char, 3>;
   using Parts = itk::Image<unsigned int, 3>;
-  auto mask = Mask::New();
-  Mask::RegionType region;
-  for (int d = 0; d < 3; ++d) region.SetSize(d, labels.size[d]);
-  mask->SetRegions(region);
-  mask->Allocate();
-  const auto target = static_cast<float>(label);
-  unsigned char* m = mask->GetBufferPointer();
-  for (std::size_t i = 0; i < labels.num_voxels(); ++i) m[i] = labels.data[i] == target ? 1 : 0;
+  const Mask::Pointer mask = label_mask_image(labels, label);
+  const unsigned char* m = mask->GetBufferPointer();
 
   auto components = itk::ConnectedComponentImageFilter<Mask, Parts>::New();
   components->SetInput(mask);

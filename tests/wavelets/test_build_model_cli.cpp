@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -32,6 +33,20 @@ std::string write_ellipsoid_labels(const std::filesystem::path& dir) {
   const std::string path = (dir / "labels.nii.gz").string();
   write_volume(path, v, VoxelType::uint8);
   return path;
+}
+
+/// A label volume of `size` voxels of 1 mm at the origin: `label` where inside(x, y, z) holds
+/// for the voxel's index, 0 elsewhere.
+template <class Inside>
+Volume labels_where(std::array<std::size_t, 3> size, float label, Inside inside) {
+  Volume v;
+  v.size = size;
+  v.data.assign(v.num_voxels(), 0.0f);
+  for (std::size_t k = 0; k < size[2]; ++k)
+    for (std::size_t j = 0; j < size[1]; ++j)
+      for (std::size_t i = 0; i < size[0]; ++i)
+        if (inside(static_cast<double>(i), static_cast<double>(j), static_cast<double>(k))) v.at(i, j, k) = label;
+  return v;
 }
 
 /// `mrsnake -q build-model ARGS` must exit with exit_code, say `mentions`, and leave no model at `model`.
@@ -191,16 +206,10 @@ TEST(BuildModelCli, CloseTunnelsMakesAGenusOneLabelModelable) {
   // A torus (major radius 9, minor 5.5 voxels; its hole has radius 3.5): genus 1, which the
   // remesher refuses, unless --close-tunnels fills the hole first.
   const auto dir = scratch_dir("build-model-cli-torus");
-  Volume v;
-  v.size = {40, 40, 40};
-  v.data.assign(v.num_voxels(), 0.0f);
-  for (std::size_t k = 0; k < 40; ++k)
-    for (std::size_t j = 0; j < 40; ++j)
-      for (std::size_t i = 0; i < 40; ++i) {
-        const double x = i - 19.5, y = j - 19.5, z = k - 19.5;
-        const double ring = std::hypot(x, y) - 9.0;
-        if (ring * ring + z * z <= 5.5 * 5.5) v.at(i, j, k) = 4.0f;
-      }
+  const Volume v = labels_where({40, 40, 40}, 4.0f, [](double i, double j, double k) {
+    const double ring = std::hypot(i - 19.5, j - 19.5) - 9.0;
+    return ring * ring + (k - 19.5) * (k - 19.5) <= 5.5 * 5.5;
+  });
   const std::string labels = (dir / "torus.nii.gz").string();
   write_volume(labels, v, VoxelType::uint8);
   const std::string model = (dir / "torus.model").string();
@@ -233,16 +242,10 @@ namespace {
 /// A capsule of label 1 along x: radius `radius` voxels, `length` voxels between the centres of
 /// its caps, in a grid 20 voxels longer and 24 voxels across.
 std::string write_tube_labels(const std::filesystem::path& dir, int length, double radius) {
-  Volume v;
-  v.size = {static_cast<std::size_t>(length) + 20, 24, 24};
-  v.data.assign(v.num_voxels(), 0.0f);
-  for (std::size_t k = 0; k < v.size[2]; ++k)
-    for (std::size_t j = 0; j < v.size[1]; ++j)
-      for (std::size_t i = 0; i < v.size[0]; ++i) {
-        const double axis = std::clamp(static_cast<double>(i), 10.0, 10.0 + length);
-        const double x = i - axis, y = j - 11.5, z = k - 11.5;
-        if (x * x + y * y + z * z <= radius * radius) v.at(i, j, k) = 1.0f;
-      }
+  const Volume v = labels_where({static_cast<std::size_t>(length) + 20, 24, 24}, 1.0f, [&](double i, double j, double k) {
+    const double x = i - std::clamp(i, 10.0, 10.0 + length), y = j - 11.5, z = k - 11.5;
+    return x * x + y * y + z * z <= radius * radius;
+  });
   const std::string path = (dir / ("tube" + std::to_string(length) + ".nii.gz")).string();
   write_volume(path, v, VoxelType::uint8);
   return path;
@@ -280,15 +283,10 @@ TEST(BuildModelCli, ComponentModelsOnePartOfALabelAndRecordsIt) {
   // Label 3 on two balls, like a left and a right organ under one label: radius 7 about
   // voxel (10, 12, 12) and radius 5 about (30, 12, 12).
   const auto dir = scratch_dir("build-model-cli-parts");
-  Volume v;
-  v.size = {42, 24, 24};
-  v.data.assign(v.num_voxels(), 0.0f);
-  for (std::size_t k = 0; k < v.size[2]; ++k)
-    for (std::size_t j = 0; j < v.size[1]; ++j)
-      for (std::size_t i = 0; i < v.size[0]; ++i) {
-        const double y = j - 12.0, z = k - 12.0, left = i - 10.0, right = i - 30.0;
-        if (left * left + y * y + z * z <= 49.0 || right * right + y * y + z * z <= 25.0) v.at(i, j, k) = 3.0f;
-      }
+  const Volume v = labels_where({42, 24, 24}, 3.0f, [](double i, double j, double k) {
+    const double y = j - 12.0, z = k - 12.0, left = i - 10.0, right = i - 30.0;
+    return left * left + y * y + z * z <= 49.0 || right * right + y * y + z * z <= 25.0;
+  });
   const std::string labels = (dir / "two.nii.gz").string();
   write_volume(labels, v, VoxelType::uint8);
 
