@@ -98,6 +98,14 @@ void add_remesh_command(CLI::App& app) {
   cmd->add_flag("--json", args->json, "Print report.json to stdout");
   cmd->footer("Example: mrsnake remesh liver.vtp -o liver_model --faces 16000");
   cmd->callback([args] {
+    // Only an earlier remesh output is replaced: checked before the work, and at the end.
+    const ReplaceableFolder earlier = folder_of_entries(
+        [](const std::string& name) {
+          return name == "report.json" || name == "report.html" ||
+                 (name.rfind("level_", 0) == 0 && std::filesystem::path(name).extension() == ".vtp");
+        },
+        "an output of mrsnake remesh");
+    require_replaceable(args->out, earlier);
     const TriMesh input = read_mesh(args->mesh);
     RemeshOptions options = args->options;
     options.repair_coarse_levels = !args->repair_finest_only;
@@ -116,7 +124,7 @@ void add_remesh_command(CLI::App& app) {
     }
     // Everything is computed before anything is written, into a temporary folder renamed
     // into place at the end: a failure or an interrupt leaves nothing under DIR.
-    AtomicDirectory out(args->out);
+    AtomicDirectory out(args->out, earlier);
     const std::filesystem::path dir(out.temp_path());
     for (int j = 0; j <= result.connectivity.levels(); ++j)
       write_mesh((dir / ("level_" + std::to_string(j) + ".vtp")).string(), result.mesh(j));

@@ -82,15 +82,14 @@ struct SegmentCaseOutcome {
 SegmentCaseOutcome segment_case(const SegmentCase& c, const SnakeModel& model, const std::string& model_path,
                                 const SegmentOptions& options, double model_load_seconds, const ProgressFn& progress) {
   // The folder is replaced at the end: only an earlier result may be, never other data (an
-  // output named after a DICOM input folder would be that folder).
-  if (std::error_code ec; std::filesystem::exists(c.output, ec)) {
-    const std::filesystem::path out(c.output);
-    const bool earlier_result = std::filesystem::is_directory(out, ec) &&
-                                (std::filesystem::is_empty(out, ec) || std::filesystem::exists(out / "report.json", ec));
-    if (!earlier_result)
-      throw OutputError("'" + c.output + "' exists and is not an output of mrsnake segment (no report.json); choose " +
-                        "another output folder, or move it away");
-  }
+  // output named after a DICOM input folder would be that folder). Checked before the work too.
+  const ReplaceableFolder earlier = folder_of_entries(
+      [](const std::string& name) {
+        return name == "surface.vtp" || name == "labels.nii.gz" || name == "levels" || name == "report.json" ||
+               name == "report.html";
+      },
+      "an output of mrsnake segment");
+  require_replaceable(c.output, earlier);
   const auto t_load = std::chrono::steady_clock::now();
   report(progress, "load", 0.0);
   const Volume image = read_volume(c.image);
@@ -147,7 +146,7 @@ SegmentCaseOutcome segment_case(const SegmentCase& c, const SnakeModel& model, c
 
   // Everything goes to a temporary folder renamed into place at the end.
   report(progress, "write", 0.0);
-  AtomicDirectory out(c.output);
+  AtomicDirectory out(c.output, earlier);
   const std::filesystem::path dir = out.temp_path();
   std::filesystem::create_directories(dir / "levels");
   const auto write_meshes = [&] {
@@ -274,7 +273,7 @@ std::vector<std::string> case_names(const std::vector<std::string>& images) {
     if (p.filename().empty()) p = p.parent_path();  // a folder given with a trailing slash
     Entry e;
     e.name = p.filename().string();
-    if (!std::filesystem::is_directory(p)) {  // a DICOM folder's name (a UID, 1.2.840...) is kept whole
+    if (std::error_code ec; !std::filesystem::is_directory(p, ec)) {  // a DICOM folder's name (a UID, 1.2.840...) is kept whole
       if (e.name.size() > 3 && e.name.compare(e.name.size() - 3, 3, ".gz") == 0) e.name.resize(e.name.size() - 3);
       if (const auto dot = e.name.rfind('.'); dot != std::string::npos && dot > 0) e.name.resize(dot);
     }
@@ -318,8 +317,10 @@ std::vector<std::string> case_names(const std::vector<std::string>& images) {
   std::set<std::string> taken{"batch.json", "batch.csv"};
   std::vector<std::string> names;
   for (const Entry& e : entries) {
-    std::string name = e.name;
-    for (int n = 2; taken.count(name) > 0; ++n) name = e.name + "_" + std::to_string(n);
+    std::string base = e.name;  // a parent's name in front may bring a leading dot back (.cache_a)
+    base.erase(0, base.find_first_not_of('.'));
+    std::string name = base;
+    for (int n = 2; taken.count(name) > 0; ++n) name = base + "_" + std::to_string(n);
     taken.insert(name);
     names.push_back(name);
   }
@@ -362,7 +363,7 @@ std::string batch_csv(const nlohmann::json& cases) {
 // relative paths are relative to the list's folder.
 std::vector<std::string> read_image_list(const std::string& list) {
   std::ifstream in(list);
-  if (!in || !std::filesystem::is_regular_file(list))
+  if (std::error_code ec; !in || std::filesystem::is_directory(list, ec))
     throw InputError("cannot read the image list '" + list + "' (a text file, one path per line); check the path");
   std::vector<std::string> images;
   const std::filesystem::path base = std::filesystem::path(list).parent_path();
@@ -491,7 +492,11 @@ void run_batch_in_processes(int jobs, const std::vector<std::string>& images, co
         worker.pending.erase(0, end + 1);
         const auto index = message["index"].get<std::size_t>();
         reported[index] = true;
-        done(index, message["row"]);
+        // The paths as given: the line's JSON text replaced any bytes that are not UTF-8.
+        nlohmann::json row = message["row"];
+        row["image"] = images[index];
+        row["output"] = outputs[index];
+        done(index, std::move(row));
       }
     }
   }

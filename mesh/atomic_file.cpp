@@ -122,8 +122,30 @@ void AtomicOutput::commit() {
   committed_ = true;
 }
 
-AtomicDirectory::AtomicDirectory(std::string final_path) : final_(std::move(final_path)) {
+ReplaceableFolder folder_of_entries(std::function<bool(const std::string& name)> ours, std::string description) {
+  return {[ours = std::move(ours)](const fs::path& folder) {
+            std::error_code ec;
+            if (!fs::is_directory(folder, ec)) return false;
+            fs::directory_iterator it(folder, ec);
+            if (ec) return false;
+            for (const fs::directory_entry& e : it)
+              if (!ours(e.path().filename().string())) return false;
+            return true;
+          },
+          std::move(description)};
+}
+
+void require_replaceable(const std::string& path, const ReplaceableFolder& replaceable) {
+  std::error_code ec;
+  if (fs::exists(path, ec) && !replaceable.test(path))
+    throw OutputError("'" + path + "' exists and is not " + replaceable.description +
+                      "; choose another output folder, or move it away");
+}
+
+AtomicDirectory::AtomicDirectory(std::string final_path, ReplaceableFolder replaceable)
+    : final_(std::move(final_path)), replaceable_(std::move(replaceable)) {
   while (!final_.empty() && final_.back() == '/') final_.pop_back();
+  require_replaceable(final_, replaceable_);
   ensure_writable_directory(fs::path(final_).parent_path().string());
   temp_ = temp_name_beside(final_);
   slot_ = register_temp(temp_);
@@ -149,6 +171,12 @@ void AtomicDirectory::commit() {
     old = temp_name_beside(final_ + ".old");
     fs::rename(final_, old, ec);
     if (ec) throw OutputError("cannot replace the existing '" + final_ + "': " + ec.message());
+    // Checked again once aside: something may have been put there since the start.
+    if (!replaceable_.test(old)) {
+      fs::rename(old, final_, ec);
+      throw OutputError("'" + final_ + "' changed while mrsnake was writing and is not " + replaceable_.description +
+                        " any more; the new output was not put in place");
+    }
   }
   fs::rename(temp_, final_, ec);
   if (ec) {

@@ -241,6 +241,15 @@ nlohmann::json stats_to_json(const DetailStats& s) {
           {"degenerate_frames", s.degenerate_frames}};
 }
 
+// What a model may replace: a model folder (with its manifest) or an empty one.
+ReplaceableFolder model_folder() {
+  return {[](const fs::path& folder) {
+            std::error_code ec;
+            return fs::is_directory(folder, ec) && (fs::exists(folder / kManifest, ec) || fs::is_empty(folder, ec));
+          },
+          "a model folder"};
+}
+
 }  // namespace
 
 std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size) {
@@ -266,16 +275,9 @@ void save_model(const std::string& folder, const ShapeModel& model, const Progre
   if (final_path.empty()) throw OutputError("empty model folder name; give a path such as liver.model");
   const fs::path parent = final_path.has_parent_path() ? final_path.parent_path() : fs::path(".");
   ensure_writable_directory(parent.string());
-  std::error_code ec;
-  if (fs::exists(final_path, ec)) {
-    const bool is_model = fs::is_directory(final_path, ec) &&
-                          (fs::exists(final_path / kManifest, ec) || fs::is_empty(final_path, ec));
-    if (!is_model)
-      throw OutputError("'" + final_path.string() + "' exists and is not a model folder; choose another output path or remove it");
-  }
   // Written into a temporary folder beside the final one, renamed into place at the end
-  // (and removed on an error or an interrupt).
-  AtomicDirectory out(final_path.string());
+  // (and removed on an error or an interrupt). Only a model folder is replaced.
+  AtomicDirectory out(final_path.string(), model_folder());
   const fs::path temp = out.temp_path();
 
   report(progress, "write model", 0.0);

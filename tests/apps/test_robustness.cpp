@@ -340,8 +340,9 @@ TEST_F(Robustness, BatchNamesAreDistinctAndNeverReplaceOtherData) {
   // hidden, that are not UTF-8 (byte 0xFF), and one named like a folder of other data in -o.
   const fs::path in = *dir_ / "names";
   fs::create_directories(in / "d");
-  const std::vector<std::string> files{"x.nii.gz",   "d/x_2.nii.gz", "batch.json.nii.gz", "..nii.gz",
-                                       "bad\xff.nii.gz", "precious.nii.gz"};
+  fs::create_directories(in / ".cache");
+  const std::vector<std::string> files{"x.nii.gz",        "d/x_2.nii.gz",    "batch.json.nii.gz", "..nii.gz",
+                                       "bad\xff.nii.gz", "precious.nii.gz", ".cache/x_2.nii.gz"};
   for (const std::string& f : files) fs::copy_file(path("tgt/image.nii.gz"), in / f);
   const fs::path out = *dir_ / "names-out";
   fs::create_directories(out / "precious");
@@ -367,7 +368,20 @@ TEST_F(Robustness, BatchNamesAreDistinctAndNeverReplaceOtherData) {
     }
   }
   EXPECT_TRUE(fs::is_regular_file(out / "batch.json"));
+  // batch.csv keeps the path's bytes as given, from a worker process too.
+  const auto csv = mrsnake::test::read_all(out / "batch.csv");
+  EXPECT_NE(std::string(csv.begin(), csv.end()).find("bad\xff.nii.gz"), std::string::npos);
   EXPECT_TRUE(fs::exists(out / "precious" / "notes.txt")) << "another program's folder was replaced";
+  // A report.json beside other files does not make a folder an earlier result.
+  std::ofstream(out / "precious" / "report.json") << "{}";
+  EXPECT_EQ(run_mrsnake("-q segment --image " + path("tgt/image.nii.gz") + " --model " + path("ellipsoid.model") +
+                        " -o " + (out / "precious").string())
+                .exit_code,
+            4);
+  fs::remove(out / "precious" / "report.json");
+  // Nor does remesh replace other data.
+  expect_one_line_error(run_mrsnake("remesh " + path("ref/truth.vtp") + " --faces 512 -o " + (out / "precious").string()),
+                        4, "exists and is not an output of mrsnake remesh");
   // The single command refuses such a folder too, and replaces an earlier result.
   const auto single = run_mrsnake("segment --image " + path("tgt/image.nii.gz") + " --model " + path("ellipsoid.model") +
                                   " -o " + (out / "precious").string());
