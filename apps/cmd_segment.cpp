@@ -66,9 +66,7 @@ void write_segment_page(const std::filesystem::path& path, const std::string& im
   mrsnake::reports::write_segment_report(path.string(), page);
 }
 
-// One image segmented into an output folder: the image (and truth) read, the snake, the
-// labels and the self-intersection count, then every output written to a temporary folder
-// renamed into place. Returns report.json's content.
+// One image to segment, and where.
 struct SegmentCase {
   std::string image, truth, output;
   int truth_label = 1;
@@ -79,6 +77,9 @@ struct SegmentCaseOutcome {
   SegmentResult result;
 };
 
+// One image segmented into its output folder: the image (and truth) read, the snake, the
+// labels and the self-intersection count, then every output written to a temporary folder
+// renamed into place. Returns report.json's content and the segmentation.
 SegmentCaseOutcome segment_case(const SegmentCase& c, const SnakeModel& model, const std::string& model_path,
                                 const SegmentOptions& options, double model_load_seconds, const ProgressFn& progress) {
   // The folder is replaced at the end: only an earlier result may be, never other data (an
