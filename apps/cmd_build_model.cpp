@@ -18,10 +18,33 @@
 #include "mesh/marching_cubes.h"
 #include "mesh/quality.h"
 #include "remesh/remesh.h"
+#include "snake/label_fit.h"
 #include "snake/model_bridge.h"
+#include "snake/structure_scale.h"
 #include "wavelets/model_io.h"
 
 namespace mrsnake::cli {
+
+namespace {
+// Why a model lost its organ, and what to type about it.
+std::string poor_fit_message(const LabelFit& fit, const StructureScale& scale, double mc_spacing, bool spacing_given) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "the model's finest level covers its label with Dice %.3f (volume %+.0f %%, below the %.2f accepted)",
+                fit.dice, 100.0 * (fit.volume_ratio - 1.0), kMinLabelFitDice);
+  std::string cause;
+  if (mc_spacing > 0 && spacing_given) {
+    char c[200];
+    std::snprintf(c, sizeof c, "; the marching-cubes spacing %.3g mm is coarse for a structure of radius %.3g mm: give "
+                  "a smaller --mc-spacing (e.g. %.3g)", mc_spacing, scale.equivalent_radius_mm, scale.finest_voxel_mm);
+    cause = c;
+  } else {
+    cause = "; the label may be too thin or ragged for a closed genus-0 model: check it with 'mrsnake mc', try "
+            "--mc-spacing 0 or more --faces";
+  }
+  return buf + cause + ", or give --allow-poor-fit to keep it";
+}
+}  // namespace
 
 void add_build_model_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("build-model",
@@ -29,10 +52,10 @@ void add_build_model_command(CLI::App& app) {
                                  "semi-regular remeshing, lifting-wavelet analysis");
   struct Args {
     std::string labels, output, predict = "butterfly", image;
-    int label = 1, levels = 0, faces = 32768, smooth = 20, close_tunnels = 0, component = 0;
-    double mc_spacing = -1;  // automatic: see --mc-spacing
-    bool full_report = false, json = false, compare_unrelaxed = false;
-    double reference_margin_mm = 20.0;
+    int label = 1, levels = 0, faces = 0, smooth = 20, close_tunnels = 0, component = 0;
+    double mc_spacing = -1;  // derived from the structure: see --mc-spacing
+    bool full_report = false, json = false, compare_unrelaxed = false, allow_poor_fit = false;
+    double reference_margin_mm = -1;  // derived from the structure: see --reference-margin
     SphereMap sphere_map = SphereMap::automatic;
     // Off by default, unlike remesh: a model's vertices stay on the reference surface. With the
     // fit, the segmentation bench's 128³ Dice fell by 0.0002-0.0004 on 9 of 10 cases
@@ -50,7 +73,9 @@ void add_build_model_command(CLI::App& app) {
   cmd->add_option("--label", a->label, "Label value of the object")->required();
   cmd->add_option("-o,--output", a->output, "Output model folder (replaced if it is already a model)")->required();
   auto* levels = cmd->add_option("--levels", a->levels, "Number of levels L (1:4 splits of the base mesh)")->check(CLI::Range(1, 10));
-  auto* faces = cmd->add_option("--faces", a->faces, "Wanted face count of the finest level (default 32768)")
+  auto* faces = cmd->add_option("--faces", a->faces,
+                                "Wanted face count of the finest level (default: triangles with edges of the surface's "
+                                "sampling length, the marching-cubes spacing or the finest voxel, 1024 to 32768)")
                     ->check(CLI::Range(16, 50000000));
   levels->excludes(faces);
   add_sphere_map_option(*cmd, a->sphere_map);
@@ -66,8 +91,9 @@ void add_build_model_command(CLI::App& app) {
                      ->check(CLI::Range(0, 1000));
   cmd->add_option("--mc-spacing", a->mc_spacing,
                   "Marching cubes on the label's Gaussian-smoothed occupancy resampled to this isotropic spacing in mm "
-                  "(default: 1.2 if the image has voxels finer than that, else 0): a smooth surface of a size the model "
-                  "needs; 0 = the voxels' own surface (as 'mrsnake mc', much slower on a large fine label)")
+                  "(default: the structure's equivalent radius / 60 if the voxels are finer than that, else 0): a "
+                  "smooth surface of a size the model needs; 0 = the voxels' own surface (as 'mrsnake mc', much slower "
+                  "on a large fine label)")
       ->check(CLI::Range(0.0, 100.0));
   cmd->add_option("--close-tunnels", a->close_tunnels,
                   "If the label's surface is not genus 0, close the label with radii up to this many voxels until it "
@@ -91,9 +117,12 @@ void add_build_model_command(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "edges", "labels"}))
       ->needs(image_option);
   cmd->add_option("--reference-margin", a->reference_margin_mm,
-                  "Margin (mm) of the stored reference image crop around the organ (with --image)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 200.0));
+                  "Margin (mm) of the stored reference image crop around the organ (with --image; default 4 "
+                  "equivalent radii of the structure)")
+      ->check(CLI::Range(0.0, 1000.0));
+  cmd->add_flag("--allow-poor-fit", a->allow_poor_fit,
+                "Write the model even when its finest level, rasterized on the label's grid, has a Dice below 0.90 "
+                "against the label (otherwise refused with exit code 5)");
   cmd->add_flag("--full-report", a->full_report, "Quality and distance to the input at every level (slower)");
   cmd->add_flag("--compare-unrelaxed", a->compare_unrelaxed,
                 "Also remesh without relaxation and compare both in MODEL/report.html (a second remeshing run)");
@@ -119,11 +148,9 @@ void add_build_model_command(CLI::App& app) {
         a->component > 0 ? keep_label_part(read_volume(a->labels), a->label, a->component) : read_volume(a->labels);
     lap("read");
 
-    // 1.2 mm keeps the liver's thin parts (docs/bench-build-model.md). An image whose voxels
-    // are all 1.2 mm or coarser gains nothing from resampling (same size, and 5 smoothing
-    // iterations leave more of its staircase than 20): its voxels' own surface is used.
-    const double finest_voxel = *std::min_element(labels.spacing.begin(), labels.spacing.end());
-    const double mc_spacing = a->mc_spacing >= 0 ? a->mc_spacing : (finest_voxel < 1.2 ? 1.2 : 0.0);
+    // Every default length follows the structure and its voxels (snake/structure_scale.h).
+    const StructureScale scale = measure_structure(labels, a->label);
+    const double mc_spacing = a->mc_spacing >= 0 ? a->mc_spacing : default_marching_cubes_spacing(scale);
     // The resampled occupancy has no staircase left to smooth away: a few iterations do.
     const int smoothing = smooth->count() == 0 && mc_spacing > 0 ? 5 : a->smooth;
     LabelSurfaceOptions mc;
@@ -149,9 +176,11 @@ void add_build_model_command(CLI::App& app) {
            " surface; closed its tunnels with a radius of " + std::to_string(surface.closing_radius) + " voxels");
     lap("marching_cubes");
 
+    const double sampling_mm = mc_spacing > 0 ? mc_spacing : scale.finest_voxel_mm;
+    const int faces = a->faces > 0 ? a->faces : default_face_count(surface.mesh, sampling_mm);
     RemeshOptions ro;
     ro.levels = a->levels;
-    ro.target_faces = a->faces;
+    ro.target_faces = faces;
     ro.sphere_map = a->sphere_map;
     ro.fit_rounds = a->fit_rounds;
     ro.curvature_weight = a->curvature_weight;
@@ -175,6 +204,19 @@ void add_build_model_command(CLI::App& app) {
     report(progress, "wavelet analysis", 1.0);
     lap("analysis");
 
+    // A model that has lost its organ is refused here, before anything is written.
+    // (Against the part the surface came from when the label's other parts were dropped, as
+    // the warning above said.)
+    const bool parts_dropped = !surface.dropped_component_faces.empty() && a->component == 0;
+    const LabelFit fit = measure_label_fit(hierarchy.mesh(hierarchy.connectivity.levels()),
+                                           parts_dropped ? keep_label_part(labels, a->label, 1) : labels, a->label);
+    if (fit.dice < kMinLabelFitDice && !a->allow_poor_fit)
+      throw AlgorithmError(poor_fit_message(fit, scale, mc_spacing, a->mc_spacing >= 0));
+    if (fit.dice < kMinLabelFitDice) warn(poor_fit_message(fit, scale, mc_spacing, a->mc_spacing >= 0));
+    lap("label_fit");
+
+    const double reference_margin_mm =
+        a->reference_margin_mm >= 0 ? a->reference_margin_mm : default_reference_margin(scale);
     std::optional<ProfileAlignmentReport> alignment;
     if (!a->image.empty()) {
       report(progress, "appearance", 0.0);
@@ -183,7 +225,7 @@ void add_build_model_command(CLI::App& app) {
       appearance.alignment = parse_profile_alignment(a->profile_alignment);
       alignment = add_appearance(model, reference, appearance);
       ReferenceImageOptions ro;
-      ro.margin_mm = a->reference_margin_mm;
+      ro.margin_mm = reference_margin_mm;
       add_reference_image(model, reference, ro);
       lap("appearance");
     }
@@ -205,6 +247,12 @@ void add_build_model_command(CLI::App& app) {
                                  {"smoothing_iterations", smoothing},
                                  {"faces", surface.mesh.num_faces()}};
     model.remesh_quality = quality;
+    model.scale = scale;
+    model.scale["marching_cubes_spacing_mm"] = mc_spacing;
+    model.scale["smoothing_iterations"] = smoothing;
+    model.scale["faces"] = faces;
+    model.scale["reference_margin_mm"] = a->image.empty() ? nlohmann::json() : nlohmann::json(reference_margin_mm);
+    model.scale["fit_to_label"] = fit;
     // The manifest records every stage up to the write; the write's own time is printed.
     model.timings = timings;
 
@@ -251,6 +299,7 @@ void add_build_model_command(CLI::App& app) {
                   {"faces", conn.faces.back().rows()},
                   {"input_faces", surface.mesh.num_faces()},
                   {"mc_spacing_mm", mc_spacing},
+                  {"scale", model.scale},
                   {"closing_radius_voxels", surface.closing_radius},
                   {"finest_level_quality", quality["finest_level_quality"]},
                   {"detail_stats", stats},
@@ -262,6 +311,9 @@ void add_build_model_command(CLI::App& app) {
     std::cout << a->output << ": " << L << " levels, " << conn.vertex_counts.back() << " vertices and "
               << conn.faces.back().rows() << " faces at the finest level (input surface: " << surface.mesh.num_faces()
               << " faces)\n";
+    std::printf("  structure %.4g mm3 (equivalent radius %.3g mm); finest level against the label: Dice %.4f, "
+                "volume %+.1f %%\n",
+                scale.volume_mm3, scale.equivalent_radius_mm, fit.dice, 100.0 * (fit.volume_ratio - 1.0));
     if (alignment)
       std::printf("  profiles centred on the %s (step residual %.3f; %d level%s moved, mean shift %+.3f mm, mean "
                   "|shift| %.3f mm)\n",

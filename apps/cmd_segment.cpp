@@ -27,6 +27,7 @@
 #include "mesh/errors.h"
 #include "mesh/image_io.h"
 #include "mesh/json_text.h"
+#include "mesh/marching_cubes.h"
 #include "mesh/mesh_io.h"
 #include "mesh/parallel.h"
 #include "snake/evaluate.h"
@@ -64,6 +65,36 @@ void write_segment_page(const std::filesystem::path& path, const std::string& im
   }
   page.report = rep;
   mrsnake::reports::write_segment_report(path.string(), page);
+}
+
+// A result whose volume is off the model's by more than this factor, either way, is flagged:
+// between the four mice the same structure's volume differs by at most 1.3×.
+constexpr double kMaxVolumeFactor = 1.5;
+
+// report.json's verdict on a result: "suspect" (bool) and "reason" (empty when not), from
+// what the run knows: the segmented volume against the model's, and a registration of the
+// reference image that was tried but not used.
+void flag_doubtful_result(nlohmann::json& rep, const SnakeModel& model) {
+  const int L = model.finest_level();
+  const double model_volume = enclosed_volume(TriMesh{model.levels[L], model.faces(L)});
+  const double volume = rep["volume_mm3"].get<double>();
+  const double ratio = model_volume > 0 ? volume / model_volume : 0.0;
+  rep["model_volume_mm3"] = model_volume;
+  rep["volume_ratio_to_model"] = ratio;
+  std::vector<std::string> reasons;
+  if (!(ratio <= kMaxVolumeFactor && ratio >= 1.0 / kMaxVolumeFactor)) {
+    char text[160];
+    std::snprintf(text, sizeof text, "the volume is %.2f times the model's (accepted: %.2f to %.2f)", ratio,
+                  1.0 / kMaxVolumeFactor, kMaxVolumeFactor);
+    reasons.emplace_back(text);
+  }
+  if (rep.contains("registration") && !rep["registration"].value("accepted", false))
+    reasons.push_back("the reference image registration was rejected (" +
+                      rep["registration"].value("rejection", std::string()) + ")");
+  std::string reason;
+  for (const std::string& r : reasons) reason += (reason.empty() ? "" : "; ") + r;
+  rep["suspect"] = !reasons.empty();
+  rep["reason"] = reason;
 }
 
 // One image to segment, and where.
@@ -137,6 +168,8 @@ SegmentCaseOutcome segment_case(const SegmentCase& c, const SnakeModel& model, c
   // What a screening study compares: the organ's volume, as labels.nii.gz holds it.
   const auto inside = static_cast<double>(std::count(labels.data.begin(), labels.data.end(), 1.0f));
   rep["volume_mm3"] = inside * labels.spacing[0] * labels.spacing[1] * labels.spacing[2];
+  flag_doubtful_result(rep, model);
+  if (rep["suspect"].get<bool>()) warn("the result is doubtful: " + rep["reason"].get<std::string>());
   if (!c.truth.empty()) {
     report(progress, "evaluate", 0.0);
     nlohmann::json scores;
@@ -347,7 +380,7 @@ std::string csv_number(const nlohmann::json& value) {
 std::string batch_csv(const nlohmann::json& cases) {
   std::string csv =
       "image,output,status,volume_mm3,compute_seconds,load_seconds,wall_seconds,self_intersections,init_used,"
-      "registration,error\n";
+      "registration,suspect,reason,error\n";
   for (const auto& c : cases) {
     csv += csv_field(c["image"].get<std::string>()) + "," + csv_field(c["output"].get<std::string>()) + "," +
            c["status"].get<std::string>() + "," + csv_number(c.value("volume_mm3", nlohmann::json())) + "," +
@@ -355,7 +388,8 @@ std::string batch_csv(const nlohmann::json& cases) {
            csv_number(c.value("load_seconds", nlohmann::json())) + "," + csv_number(c["wall_seconds"]) + "," +
            (c.contains("self_intersections") ? std::to_string(c["self_intersections"].get<int>()) : std::string()) + "," +
            csv_field(c.value("init_used", std::string())) + "," + csv_field(c.value("registration", std::string())) + "," +
-           csv_field(c.value("error", std::string())) + "\n";
+           (c.contains("suspect") ? std::string(c["suspect"].get<bool>() ? "true" : "false") : std::string()) + "," +
+           csv_field(c.value("reason", std::string())) + "," + csv_field(c.value("error", std::string())) + "\n";
   }
   return csv;
 }
@@ -400,6 +434,8 @@ nlohmann::json batch_row(const std::string& image, const std::string& output, co
     row["load_seconds"] = rep["stage_seconds"]["load"];
     row["self_intersections"] = rep["self_intersections"];
     row["init_used"] = rep.value("init_used", std::string());
+    row["suspect"] = rep["suspect"];
+    row["reason"] = rep["reason"];
     if (rep.contains("registration"))
       row["registration"] = rep["registration"].value("accepted", false) ? "accepted" : "rejected";
   } catch (const Error& e) {

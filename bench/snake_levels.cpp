@@ -91,8 +91,8 @@ int main(int argc, char** argv) {
     else if (key == "reg_eval") reg.evaluation_samples = static_cast<int>(v);
     else if (key == "reg_change") reg.min_relative_change = v;
     else if (key == "reg_window") reg.convergence_window = static_cast<int>(v);
-    else if (key == "reg_min_step") reg.min_step_mm = v;
-    else if (key == "reg_step") reg.initial_step_mm = v;
+    else if (key == "reg_min_step") reg.min_step_voxels = v;
+    else if (key == "reg_step") reg.initial_step_voxels = v;
     else if (key == "smoothing") o.snake.offset_smoothing = static_cast<int>(v);
     else if (key == "fine_deform") o.fine.deform_edge_centred = v != 0;
     else if (key == "fine_min_iterations") o.fine.min_iterations = static_cast<int>(v);

@@ -293,7 +293,7 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
     corners.push_back(q);
   }
   std::array<long, 3> lo{}, hi{};
-  if (!index_box_of_points(moving, corners, o.moving_margin_fraction, o.moving_margin_mm, lo, hi))
+  if (!index_box_of_points(moving, corners, o.moving_margin_fraction, o.moving_margin_voxels * fixed.max_spacing(), lo, hi))
     throw InputError("the model's reference image does not overlap the image; use another --init");
   for (int a = 0; a < 3; ++a)
     if (hi[a] - lo[a] < 3) throw InputError("the model's reference image barely overlaps the image; use another --init");
@@ -365,8 +365,9 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
       metric->SetMaximumNumberOfWorkUnits(static_cast<itk::ThreadIdType>(std::max(1, o.threads)));
       optimizer = Optimizer::New();
       // Each finer level starts from the coarser one's result: shorter first steps.
-      optimizer->SetLearningRate(o.initial_step_mm * std::pow(o.step_factor_per_level, static_cast<double>(l)));
-      optimizer->SetMinimumStepLength(o.min_step_mm);
+      optimizer->SetLearningRate(o.initial_step_voxels * fixed.max_spacing() *
+                                 std::pow(o.step_factor_per_level, static_cast<double>(l)));
+      optimizer->SetMinimumStepLength(o.min_step_voxels * fixed.max_spacing());
       optimizer->SetRelaxationFactor(o.relaxation);
       optimizer->SetNumberOfIterations(static_cast<itk::SizeValueType>(std::max(1, o.iterations_per_level)));
       optimizer->SetReturnBestParametersAndValue(true);

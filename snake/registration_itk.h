@@ -40,12 +40,15 @@ struct RegistrationOptions {
   /// Points of the regular grid on which the metric is evaluated at the start and at the
   /// result (full resolution), to judge the registration.
   int evaluation_samples = 4000;
-  double initial_step_mm = 3.0;                ///< the optimizer's first step (regular step descent)
+  /// The optimizer's first step (regular step descent), in voxels of the fixed image (its
+  /// largest side): lengths follow the images' scale, whether a mouse brain at 0.3 mm or an
+  /// abdomen at 3 mm.
+  double initial_step_voxels = 1.0;
   /// Radius at which rotations and scalings are measured against translations (parameter
   /// scales); <= 0: the RMS distance of the fixed image's edges from its centre.
   double rotation_radius_mm = 0;
-  double step_factor_per_level = 0.5;          ///< first step of level l: initial_step_mm · factor^l
-  double min_step_mm = 0.01;                   ///< stop when the step falls below this
+  double step_factor_per_level = 0.5;          ///< first step of level l: initial_step_voxels · factor^l
+  double min_step_voxels = 0.003;              ///< stop when the step falls below this (fixed image voxels)
   double relaxation = 0.6;                     ///< step factor when the gradient turns back
   /// Stop a level early once the metric (on that level's samples) has changed by less than
   /// this fraction of its magnitude over the last `convergence_window` iterations (0: off):
@@ -53,9 +56,10 @@ struct RegistrationOptions {
   double min_relative_change = 0.002;
   int convergence_window = 5;
   /// The part of the MOVING image used: the fixed image's box mapped by the start
-  /// transform, grown by this fraction of its size per side plus margin_mm.
+  /// transform, grown by this fraction of its size per side plus moving_margin_voxels voxels
+  /// of the fixed image.
   double moving_margin_fraction = 0.25;
-  double moving_margin_mm = 10.0;
+  double moving_margin_voxels = 4.0;
   /// A linear map applied to the moving image's intensities (e.g. its normalization, so
   /// that mean squares compares like with like).
   double moving_intensity_scale = 1.0, moving_intensity_offset = 0.0;

@@ -42,6 +42,9 @@ struct ShapeModel {
   std::optional<int> source_component;        ///< the label's k-th largest part only (build-model --component)
   std::optional<PhysicalFrame> physical_frame;
   nlohmann::json remesh_quality;               ///< mesh/quality.h keys; null if none
+  /// The structure's size and every default derived from it, with the finest level's fit to
+  /// its label (build-model); null if none.
+  nlohmann::json scale;
   std::vector<std::pair<std::string, double>> timings;  ///< seconds per stage, in order
   /// Optional named binary sections (e.g. "appearance"), stored as <name>.bin and listed,
   /// with their size and checksum, in the manifest. Names: [a-z0-9_]+, not "details".

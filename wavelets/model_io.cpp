@@ -325,6 +325,7 @@ void save_model(const std::string& folder, const ShapeModel& model, const Progre
   for (const DetailStats& s : model.detail_stats) stats.push_back(stats_to_json(s));
   m["detail_stats"] = stats;
   m["remesh_quality"] = model.remesh_quality;
+  if (!model.scale.is_null()) m["scale"] = model.scale;
   nlohmann::json timings = nlohmann::json::array();
   for (const auto& [stage, seconds] : model.timings) timings.push_back({{"stage", stage}, {"seconds", seconds}});
   m["timings"] = timings;
@@ -428,6 +429,7 @@ ShapeModel load_model(const std::string& folder, const LoadModelOptions& options
       model.physical_frame = frame;
     }
     model.remesh_quality = m.at("remesh_quality");
+    if (m.contains("scale")) model.scale = m["scale"];
     for (const nlohmann::json& t : m.at("timings"))
       model.timings.emplace_back(t.at("stage").get<std::string>(), t.at("seconds").get<double>());
     for (const nlohmann::json& s : m.at("detail_stats")) {

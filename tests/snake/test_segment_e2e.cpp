@@ -346,7 +346,7 @@ TEST(SegmentReal, LiverOfTheAbdomenCtReachesDice09WithoutSelfIntersections) {
   const auto dir = mrsnake::test::scratch_dir("segment-real-liver");
   const std::string d = dir.string();
   const auto b = mrsnake::test::run_mrsnake("-q build-model --labels " + labels + " --label 5 --image " + image +
-                                            " --close-tunnels 3 -o " + d + "/liver.model");
+                                            " --close-tunnels 3 --faces 32768 -o " + d + "/liver.model");
   ASSERT_EQ(b.exit_code, 0) << b.output;
   const auto c = mrsnake::test::run_mrsnake("-q synth --from-image " + image + " --from-labels " + labels +
                                             " --label 5 --pose random --deform 6 --seed 7 -o " + d + "/case");

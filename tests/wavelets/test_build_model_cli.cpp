@@ -69,7 +69,8 @@ TEST(BuildModelCli, BuildsAModelThatModelInfoAccepts) {
   EXPECT_GE(summary["faces"].get<int>(), 1024);
   std::vector<std::string> stages;
   for (const auto& t : summary["timings"]) stages.push_back(t["stage"]);
-  EXPECT_EQ(stages, (std::vector<std::string>{"read", "marching_cubes", "parameterization", "levels", "analysis", "report", "write"}));
+  EXPECT_EQ(stages, (std::vector<std::string>{"read", "marching_cubes", "parameterization", "levels", "analysis",
+                                              "label_fit", "report", "write"}));
 
   const ShapeModel m = load_model(model, {true});
   EXPECT_EQ(m.source_label, 3);
@@ -82,10 +83,23 @@ TEST(BuildModelCli, BuildsAModelThatModelInfoAccepts) {
   EXPECT_NEAR(center.y(), 30.0 + 17.5, 1.0);
   EXPECT_NEAR(center.z(), 5.0 + 15.5 * 1.25, 1.0);
   EXPECT_TRUE(m.remesh_quality.contains("finest_level_quality"));
-  // The marching cubes ran on the resampled occupancy (default 1.2 mm), recorded in model.json.
-  EXPECT_EQ(summary["mc_spacing_mm"].get<double>(), 1.2);
-  EXPECT_EQ(m.remesh_quality["marching_cubes"]["spacing_mm"].get<double>(), 1.2);
-  EXPECT_EQ(m.remesh_quality["marching_cubes"]["smoothing_iterations"].get<int>(), 5);
+  // The structure's size and every default derived from it are in model.json. The ellipsoid's
+  // equivalent radius over 60 is below its 1 mm voxels: the voxels' own surface, smoothed 20 times.
+  const nlohmann::json& scale = m.scale;
+  ASSERT_TRUE(scale.is_object());
+  const double radius = scale["equivalent_radius_mm"].get<double>();
+  EXPECT_NEAR(4.0 / 3.0 * M_PI * radius * radius * radius, scale["volume_mm3"].get<double>(), 1e-6 * radius * radius * radius);
+  EXPECT_EQ(scale["finest_voxel_mm"].get<double>(), 1.0);
+  EXPECT_LT(radius / 60.0, 1.0);
+  EXPECT_EQ(summary["mc_spacing_mm"].get<double>(), 0.0);
+  EXPECT_EQ(scale["marching_cubes_spacing_mm"].get<double>(), 0.0);
+  EXPECT_EQ(m.remesh_quality["marching_cubes"]["spacing_mm"].get<double>(), 0.0);
+  EXPECT_EQ(m.remesh_quality["marching_cubes"]["smoothing_iterations"].get<int>(), 20);
+  EXPECT_EQ(scale["faces"].get<int>(), 2048);  // as given
+  EXPECT_TRUE(scale["reference_margin_mm"].is_null());  // no --image
+  // The finest level, rasterized on the label's grid, matches the label.
+  EXPECT_GT(scale["fit_to_label"]["dice"].get<double>(), 0.95);
+  EXPECT_NEAR(scale["fit_to_label"]["volume_ratio"].get<double>(), 1.0, 0.05);
   EXPECT_EQ(m.remesh_quality["marching_cubes"]["faces"].get<int>(), summary["input_faces"].get<int>());
 
   // A small surface takes the punctured sphere map by default.
@@ -261,8 +275,10 @@ TEST(BuildModelCli, LongTubesArePuncturedInTheMiddleAndTheTooLongRefusedAsTooDis
   // the second is refused for its distortion, which is what is wrong with it.
   const auto dir = scratch_dir("build-model-cli-tube");
   const std::string model = (dir / "tube.model").string();
+  // (On the occupancy resampled to 1.2 voxels: the voxels' own surface of so thin a tube
+  // stretches past the limit from any pole.)
   const auto built = run_mrsnake("-q build-model --labels " + write_tube_labels(dir, 70, 2.5) + " --label 1 -o " + model +
-                                 " --faces 2048 --json");
+                                 " --faces 2048 --mc-spacing 1.2 --json");
   ASSERT_EQ(built.exit_code, 0) << built.output;
   const auto summary = nlohmann::json::parse(built.output);
   EXPECT_EQ(summary["faces"], 2048);
@@ -270,7 +286,7 @@ TEST(BuildModelCli, LongTubesArePuncturedInTheMiddleAndTheTooLongRefusedAsTooDis
   std::filesystem::remove_all(model);
 
   const auto r = run_mrsnake("-q build-model --labels " + write_tube_labels(dir, 100, 2.5) + " --label 1 -o " + model +
-                             " --faces 2048");
+                             " --faces 2048 --mc-spacing 1.2");
   EXPECT_EQ(r.exit_code, 5) << r.output;
   EXPECT_NE(r.output.find("the parameterization is too distorted (area stretch spans "), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("long protrusions cannot be remeshed from one chart"), std::string::npos) << r.output;
