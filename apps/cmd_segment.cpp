@@ -72,8 +72,8 @@ void write_segment_page(const std::filesystem::path& path, const std::string& im
 constexpr double kMaxVolumeFactor = 1.5;
 
 // report.json's verdict on a result: "suspect" (bool) and "reason" (empty when not), from
-// what the run knows: the segmented volume against the model's, and a registration of the
-// reference image that was tried but not used.
+// the segmented volume against the model's. (A rejected registration is not a verdict by
+// itself: its fallback often succeeds, e.g. on synthetic blobs, and it is warned about.)
 void flag_doubtful_result(nlohmann::json& rep, const SnakeModel& model) {
   const int L = model.finest_level();
   const double model_volume = enclosed_volume(TriMesh{model.levels[L], model.faces(L)});
@@ -88,9 +88,6 @@ void flag_doubtful_result(nlohmann::json& rep, const SnakeModel& model) {
                   1.0 / kMaxVolumeFactor, kMaxVolumeFactor);
     reasons.emplace_back(text);
   }
-  if (rep.contains("registration") && !rep["registration"].value("accepted", false))
-    reasons.push_back("the reference image registration was rejected (" +
-                      rep["registration"].value("rejection", std::string()) + ")");
   std::string reason;
   for (const std::string& r : reasons) reason += (reason.empty() ? "" : "; ") + r;
   rep["suspect"] = !reasons.empty();

@@ -373,3 +373,110 @@ TEST(SegmentReal, LiverOfTheAbdomenCtReachesDice09WithoutSelfIntersections) {
   EXPECT_GE(dice[1], dice[0] - 0.005);  // the snake does not make its start worse
   std::filesystem::remove_all(dir);
 }
+
+namespace {
+
+// A blob case of mrsnake synth at `scale` (voxel size, blur and deformation all scaled), its
+// model from another instance with every build-model default, and segment's report.json.
+nlohmann::json segment_blob_at_scale(const std::string& dir, double scale) {
+  const auto mm = [scale](double x) { return std::to_string(x * scale); };
+  const std::string common = "-q synth --shape blob --size 48 --snr 6 --spacing " + mm(1.0) + " --blur " + mm(0.5);
+  const std::string ref = dir + "/ref", target = dir + "/target", model = dir + "/blob.model";
+  EXPECT_EQ(mrsnake::test::run_mrsnake(common + " --seed 3 -o " + ref).exit_code, 0);
+  EXPECT_EQ(mrsnake::test::run_mrsnake(common + " --seed 3 --pose random --deform " + mm(3.0) + " -o " + target).exit_code, 0);
+  const auto b = mrsnake::test::run_mrsnake("-q build-model --labels " + ref + "/truth.nii.gz --label 1 --image " + ref +
+                                            "/image.nii.gz -o " + model);
+  EXPECT_EQ(b.exit_code, 0) << b.output;
+  const auto s = mrsnake::test::run_mrsnake("-q segment --image " + target + "/image.nii.gz --model " + model + " -o " +
+                                            dir + "/seg --truth " + target + "/truth.nii.gz");
+  EXPECT_EQ(s.exit_code, 0) << s.output;
+  nlohmann::json rep = nlohmann::json::parse(std::ifstream(dir + "/seg/report.json"));
+  rep["model_json"] = nlohmann::json::parse(std::ifstream(model + "/model.json"));
+  return rep;
+}
+
+}  // namespace
+
+TEST(SegmentScale, TheSameCaseAtATenthOfTheScaleGivesTheSameDice) {
+  // No default is a fixed length: shrunk tenfold, voxels and all, the same case is segmented
+  // as well, and every length build-model derived shrinks with it.
+  const auto dir = mrsnake::test::scratch_dir("segment-scale");
+  const nlohmann::json full = segment_blob_at_scale((dir / "full").string(), 1.0);
+  const nlohmann::json tenth = segment_blob_at_scale((dir / "tenth").string(), 0.1);
+  const double dice_full = full["scores"]["dice"].get<double>(), dice_tenth = tenth["scores"]["dice"].get<double>();
+  std::printf("blob at scale 1: Dice %.4f; at scale 1/10: Dice %.4f\n", dice_full, dice_tenth);
+  EXPECT_GT(dice_full, 0.95);
+  EXPECT_NEAR(dice_full, dice_tenth, 0.01);
+  EXPECT_FALSE(full["suspect"].get<bool>()) << full["reason"];
+  EXPECT_FALSE(tenth["suspect"].get<bool>()) << tenth["reason"];
+  const nlohmann::json &a = full["model_json"]["scale"], &b = tenth["model_json"]["scale"];
+  EXPECT_NEAR(b["equivalent_radius_mm"].get<double>(), 0.1 * a["equivalent_radius_mm"].get<double>(), 1e-4);
+  EXPECT_NEAR(b["reference_margin_mm"].get<double>(), 0.1 * a["reference_margin_mm"].get<double>(), 1e-4);
+  EXPECT_NEAR(b["marching_cubes_spacing_mm"].get<double>(), 0.1 * a["marching_cubes_spacing_mm"].get<double>(), 1e-6);
+  EXPECT_EQ(a["faces"], b["faces"]);
+  EXPECT_EQ(full["model_json"]["vertex_counts"], tenth["model_json"]["vertex_counts"]);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(SegmentCommand, AVolumeFarFromTheModelsIsFlagged) {
+  // A model of a ball of radius 10 voxels, run with --init pose on an image that holds only
+  // its lower half (the scan cut the organ): a volume off the model's by more than 1.5× is
+  // flagged in report.json, with its reason; the whole ball is not.
+  const auto dir = mrsnake::test::scratch_dir("segment-flag");
+  const auto ball = [](std::size_t slices) {
+    Volume v;
+    v.size = {40, 40, slices};
+    v.data.assign(v.num_voxels(), 0.0f);
+    for (std::size_t k = 0; k < slices; ++k)
+      for (std::size_t j = 0; j < 40; ++j)
+        for (std::size_t i = 0; i < 40; ++i) {
+          const double x = i - 19.5, y = j - 19.5, z = k - 19.5;
+          if (x * x + y * y + z * z <= 100.0) v.at(i, j, k) = 1.0f;
+        }
+    return v;
+  };
+  const std::string whole = (dir / "whole.nii.gz").string(), half = (dir / "half.nii.gz").string();
+  write_volume(whole, ball(40), VoxelType::uint8);
+  write_volume(half, ball(20), VoxelType::uint8);
+  const std::string model = (dir / "ball.model").string();
+  ASSERT_EQ(mrsnake::test::run_mrsnake("-q build-model --labels " + whole + " --label 1 -o " + model).exit_code, 0);
+  const std::string args = " --model " + model + " --init pose --max-iterations 0 -o ";
+  const auto same = mrsnake::test::run_mrsnake("-q segment --image " + whole + args + (dir / "same").string() + " --json");
+  ASSERT_EQ(same.exit_code, 0) << same.output;
+  const nlohmann::json ok = nlohmann::json::parse(same.output);
+  EXPECT_FALSE(ok["suspect"].get<bool>()) << ok["reason"];
+  EXPECT_EQ(ok["reason"], "");
+  EXPECT_NEAR(ok["volume_ratio_to_model"].get<double>(), 1.0, 0.05);
+  const auto off = mrsnake::test::run_mrsnake("segment --image " + half + args + (dir / "off").string());
+  ASSERT_EQ(off.exit_code, 0) << off.output;
+  EXPECT_NE(off.output.find("warning: the result is doubtful: the volume is 0.5"), std::string::npos) << off.output;
+  const nlohmann::json rep = nlohmann::json::parse(std::ifstream(dir / "off" / "report.json"));
+  EXPECT_TRUE(rep["suspect"].get<bool>());
+  EXPECT_NE(rep["reason"].get<std::string>().find("times the model's (accepted: 0.67 to 1.50)"), std::string::npos)
+      << rep["reason"];
+  std::filesystem::remove_all(dir);
+}
+
+TEST(SegmentReal, OneMouseModelSegmentsAnotherMouseHippocampusWithTheDefaults) {
+  // The screening job itself: mouse 1's hippocampus (label 1, 18.8 mm³ at 0.15 mm) modelled
+  // with every default, then segmented in mouse 2 and scored against mouse 2's own labels.
+  MRSNAKE_REQUIRE_DATA(ref_image, "volumes/mouse-brain/mouse1_image.nii.gz");
+  MRSNAKE_REQUIRE_DATA(ref_labels, "volumes/mouse-brain/mouse1_labels.nii.gz");
+  MRSNAKE_REQUIRE_DATA(image, "volumes/mouse-brain/mouse2_image.nii.gz");
+  MRSNAKE_REQUIRE_DATA(labels, "volumes/mouse-brain/mouse2_labels.nii.gz");
+  const auto dir = mrsnake::test::scratch_dir("segment-mouse");
+  const std::string model = (dir / "hippocampus.model").string();
+  const auto b = mrsnake::test::run_mrsnake("-q build-model --labels " + ref_labels + " --label 1 --image " + ref_image +
+                                            " -o " + model + " --json");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  EXPECT_GT(nlohmann::json::parse(b.output)["scale"]["fit_to_label"]["dice"].get<double>(), 0.95);
+  const auto s = mrsnake::test::run_mrsnake("-q segment --image " + image + " --model " + model + " -o " +
+                                            (dir / "seg").string() + " --truth " + labels + " --truth-label 1 --json");
+  ASSERT_EQ(s.exit_code, 0) << s.output;
+  const nlohmann::json rep = nlohmann::json::parse(s.output);
+  std::printf("mouse 1 -> mouse 2 hippocampus: Dice %.4f, %.3f s of compute\n", rep["scores"]["dice"].get<double>(),
+              rep["compute_seconds"].get<double>());
+  EXPECT_GE(rep["scores"]["dice"].get<double>(), 0.9);
+  EXPECT_FALSE(rep["suspect"].get<bool>()) << rep["reason"];
+  std::filesystem::remove_all(dir);
+}

@@ -336,3 +336,41 @@ TEST(BuildModelCli, ComponentModelsOnePartOfALabelAndRecordsIt) {
                  (dir / "part3.model").string());
   std::filesystem::remove_all(dir);
 }
+
+TEST(BuildModelCli, AModelThatLostItsOrganIsRefusedUnlessAllowed) {
+  // A ball of radius 12 voxels of 0.15 mm (1.8 mm, a mouse structure's size): a marching-cubes
+  // grid of 1.2 mm, a human organ's, leaves a blob of a few cells whose rasterized finest
+  // level misses most of the label. Refused with exit 5, naming the option that fixes it.
+  const auto dir = scratch_dir("build-model-cli-poor-fit");
+  Volume v = labels_where({32, 32, 32}, 1.0f, [](double i, double j, double k) {
+    const double x = i - 15.5, y = j - 15.5, z = k - 15.5;
+    return x * x + y * y + z * z <= 144.0;
+  });
+  v.spacing = {0.15, 0.15, 0.15};
+  const std::string labels = (dir / "ball.nii.gz").string();
+  write_volume(labels, v, VoxelType::uint8);
+  const std::string model = (dir / "ball.model").string();
+  expect_refused("--labels " + labels + " --label 1 -o " + model + " --mc-spacing 1.2", 5,
+                 "the model's finest level covers its label with Dice ", model);
+  const auto refused = run_mrsnake("-q build-model --labels " + labels + " --label 1 -o " + model + " --mc-spacing 1.2");
+  EXPECT_NE(refused.output.find("give a smaller --mc-spacing (e.g. 0.15)"), std::string::npos) << refused.output;
+  EXPECT_NE(refused.output.find("--allow-poor-fit"), std::string::npos) << refused.output;
+
+  // Allowed: written, with a warning and the fit in model.json.
+  const auto allowed =
+      run_mrsnake("-q build-model --labels " + labels + " --label 1 -o " + model + " --mc-spacing 1.2 --allow-poor-fit");
+  ASSERT_EQ(allowed.exit_code, 0) << allowed.output;
+  EXPECT_NE(allowed.output.find("warning: the model's finest level covers its label with Dice "), std::string::npos)
+      << allowed.output;
+  const ShapeModel poor = load_model(model, {true});
+  EXPECT_LT(poor.scale["fit_to_label"]["dice"].get<double>(), 0.9);
+  std::filesystem::remove_all(model);
+
+  // The defaults, derived from the ball and its voxels, keep it.
+  const auto built = run_mrsnake("-q build-model --labels " + labels + " --label 1 -o " + model + " --json");
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  const auto summary = nlohmann::json::parse(built.output);
+  EXPECT_GT(summary["scale"]["fit_to_label"]["dice"].get<double>(), 0.95);
+  EXPECT_NEAR(summary["scale"]["equivalent_radius_mm"].get<double>(), 1.8, 0.05);
+  std::filesystem::remove_all(dir);
+}
