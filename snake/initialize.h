@@ -82,7 +82,9 @@ Similarity moments_alignment(const Volume& image, const TriMesh& model, const Mo
 struct TargetFitOptions {
   int iterations = 30;
   bool with_scale = true;   ///< similarity (true) or rigid (false)
-  double tolerance_mm = 0.01;  ///< stop when the mean vertex motion of an iteration is below this
+  /// Stop when the mean vertex motion of an iteration is below this (mm). segment sets it
+  /// from SegmentOptions::fit_tolerance_voxels and the image's voxels.
+  double tolerance_mm = 0.01;
   double trim_fraction = 0.2;  ///< drop the worst-matching fraction of vertices each iteration
 };
 

@@ -359,11 +359,13 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     const double fit_range = range_for(jf, options.coarse_range_edge_fraction, options.fit_min_range_voxels);
     const auto [search, step] = search_for(jf, fit_range, stats, nullptr, options.profile_step_fraction);
     (void)step;
+    TargetFitOptions fit_options = options.fit;
+    fit_options.tolerance_mm = options.fit_tolerance_voxels * spacings[0];
     double best_cost = std::numeric_limits<double>::infinity();
     for (const auto& [start, start_name] : starts) {
       RowMatrixX3d W = start.apply(model.levels[jf]);
       int iterations = 0;
-      const Similarity fitted = fit_similarity_to_targets(W, model.faces(jf), search, options.fit, &iterations);
+      const Similarity fitted = fit_similarity_to_targets(W, model.faces(jf), search, fit_options, &iterations);
       vertex_normals(W, model.faces(jf), N);
       const double cost = search(W, N).costs.mean();
       if (cost < best_cost) {

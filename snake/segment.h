@@ -100,6 +100,9 @@ struct SegmentOptions {
   ForceMode force = ForceMode::automatic;
   double clean_step_max_residual = 0.2;
   TargetFitOptions fit;
+  /// The fit stops when its mean vertex motion falls below this many voxels of the image
+  /// (its tolerance_mm is set from it).
+  double fit_tolerance_voxels = 0.01;
   int fit_level = 2;  ///< the mesh level whose vertices the similarity fit uses (capped at L)
   MomentsOptions moments;
   /// Search range at level j: max(min_range_voxels·voxel, range_edge_fraction·edge_j); the
