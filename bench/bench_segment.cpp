@@ -3,12 +3,17 @@
 // synthetic cases (mrsnake synth) or on real images warped by a known deformation
 // (synth --from-image). One table: Dice, ASSD, HD95, seconds of compute after loading,
 // load seconds, peak memory and the speed-up of the snake over the best ITK level set.
+// On real data a second table sets the snake beside single-atlas elastix (bench/elastix_atlas):
+// the reference image registered to the case, its truth warped onto the case's grid.
 //
 // Usage: bench_segment [--quick] [--real DATA_DIR] [--mrsnake BIN] [--work DIR] [--json OUT] [--keep]
 //                      [--only CASE_SUBSTRING] [--gac PROPAGATION,CURVATURE,ADVECTION[,SIGMA_MM,BETA_FRACTION,ALPHA_DIVISOR]]
+//                      [--elastix-atlas SCRIPT]
 //   --keep also writes each level set's labels into the work folder.
 //   default: synthetic cases at 128³ and 256³; --quick: 128³ only;
 //   --real DATA_DIR: the liver of abdomen-ct-small and the genus-0 brain structures of MRIcrop.
+//   --elastix-atlas: the bench/elastix_atlas script (default: the one beside this source file);
+//     the elastix columns are skipped when elastix or transformix is not on PATH.
 //
 // Every mrsnake command runs as a child process (wall time and peak RSS from wait4); each
 // ITK level set runs in a forked child of this driver with one thread, so its peak RSS is
@@ -29,6 +34,7 @@
 #include <functional>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -39,6 +45,7 @@
 #include "bench/itk_level_sets.h"
 #include "mesh/atomic_file.h"
 #include "mesh/image_io.h"
+#include "mesh/label_repair.h"
 #include "snake/evaluate.h"
 
 namespace fs = std::filesystem;
@@ -154,6 +161,76 @@ struct InitRow {
   std::string registration;  ///< "accepted", "rejected: why", or "" when not asked for
 };
 
+/// Single-atlas elastix on one real case (bench/elastix_atlas), scored against the case's truth.
+struct ElastixRow {
+  std::string case_name, dataset;
+  SegmentationScores scores;  ///< Dice 0 and infinite distances when it failed
+  double registration_seconds = std::numeric_limits<double>::quiet_NaN();  ///< elastix's wall seconds
+  double transformix_seconds = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> fixed_spacing_mm, grid_spacing_mm;  ///< the case's voxels; the final B-spline grid elastix laid
+  std::string error;
+  json record;  ///< elastix_atlas's output
+};
+
+/// FinalGridSpacingInVoxels of elastix's B-spline stage: in voxels, so the grid follows each
+/// dataset's scale (as bench/cross_subject).
+constexpr int kElastixGridVoxels = 8;
+
+/// Whether an executable of this name is on PATH.
+bool on_path(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  std::stringstream dirs(path ? path : "");
+  for (std::string dir; std::getline(dirs, dir, ':');)
+    if (!dir.empty() && access((fs::path(dir) / name).c_str(), X_OK) == 0) return true;
+  return false;
+}
+
+double number_or_nan(const json& j, const char* key) {
+  return j.is_object() && j.contains(key) && j[key].is_number() ? j[key].get<double>()
+                                                                : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::vector<double> numbers(const json& j, const char* key) {
+  std::vector<double> out;
+  if (j.is_object() && j.contains(key) && j[key].is_array())
+    for (const json& v : j[key]) out.push_back(v.get<double>());
+  return out;
+}
+
+/// A table cell: "–" for NaN, "inf", or the number in printf format f.
+std::string cell(double v, const char* f) {
+  if (std::isnan(v)) return "–";
+  if (std::isinf(v)) return "inf";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+/// A mean over the cases of a table column: its finite values, and how many were not.
+struct ColumnMean {
+  double sum = 0;
+  int finite = 0, left_out = 0;
+  void add(double v) {
+    if (std::isfinite(v)) {
+      sum += v;
+      ++finite;
+    } else if (!std::isnan(v)) {
+      ++left_out;
+    }
+  }
+  std::string text(const char* f) const {
+    std::string t = cell(finite > 0 ? sum / finite : std::numeric_limits<double>::quiet_NaN(), f);
+    return left_out > 0 ? t + " (" + std::to_string(left_out) + " inf)" : t;
+  }
+};
+
+/// "3 mm" for isotropic spacings, else "0.6×0.6×1.3 mm".
+std::string spacing_text(const std::vector<double>& mm) {
+  if (mm.size() != 3) return "? mm";
+  if (std::abs(mm[0] - mm[1]) < 1e-6 && std::abs(mm[0] - mm[2]) < 1e-6) return cell(mm[0], "%g") + " mm";
+  return cell(mm[0], "%.3g") + "×" + cell(mm[1], "%.3g") + "×" + cell(mm[2], "%.3g") + " mm";
+}
+
 /// The initialization columns of a segment report.
 void fill_init_row(InitRow& row, const json& rep) {
   row.init_used = rep.value("init_used", std::string());
@@ -174,9 +251,12 @@ struct Bench {
   std::string primary_init;              ///< --init of the snake whose start the level sets share (empty: default)
   std::vector<std::string> extra_inits;  ///< also run the snake with these --init modes
   std::string only;  ///< run only the cases whose name contains this
+  std::string elastix_atlas;  ///< the bench/elastix_atlas script; empty: no elastix column
+  std::string elastix_skipped;  ///< why there is no elastix column (empty: it runs, or no real data)
   bench::LevelSetOptions itk_options;
   std::vector<Row> rows;
   std::vector<InitRow> init_rows;
+  std::vector<ElastixRow> elastix_rows;
   json cases = json::array();
 
   ChildResult mrsnake_cmd(const std::vector<std::string>& args, const fs::path& dir, const std::string& tag,
@@ -228,6 +308,69 @@ struct Bench {
     return s;
   }
 
+  std::string primary_method() const { return primary_init.empty() ? "mrsnake" : "mrsnake --init " + primary_init; }
+  /// The run set against elastix: segment's default route for a model with a reference image.
+  std::string elastix_rival = "mrsnake --init register+fit";
+
+  /// The reference side of a real case's truth: 1 where `labels` hold `label` (on its
+  /// `component`-th largest part only when component > 0), the mask synth --from-image warps
+  /// into the case's truth. In a forked child, so that no ITK threads start in this driver.
+  static void write_reference_truth(const fs::path& labels, int label, int component, const fs::path& out) {
+    const ChildResult r = run_forked([&] {
+      Volume v = read_volume(labels.string());
+      if (component > 0) v = keep_label_part(v, label, component);
+      for (float& x : v.data) x = std::lround(x) == label ? 1.0f : 0.0f;
+      write_volume(out.string(), v, VoxelType::uint8);
+      return 0;
+    });
+    if (r.exit_code != 0) throw std::runtime_error("writing the reference truth " + out.string() + " failed");
+  }
+
+  /// Single-atlas elastix: bench/elastix_atlas registers the reference image (moving) to the
+  /// case's image (fixed) and warps the reference truth onto the case's grid (nearest
+  /// neighbour); `mrsnake evaluate` scores it against the case's truth.
+  void run_elastix(const Case& c, const std::string& dataset, const fs::path& reference_image,
+                   const fs::path& reference_truth) {
+    if (elastix_atlas.empty() || (!only.empty() && c.name.find(only) == std::string::npos)) return;
+    std::printf("  %s: elastix", c.name.c_str());
+    std::fflush(stdout);
+    ElastixRow row;
+    row.case_name = c.name;
+    row.dataset = dataset;
+    row.scores.dice = 0;
+    row.scores.assd_mm = row.scores.hd95_mm = INFINITY;
+    const ChildResult r = run_program({elastix_atlas, "--fixed", c.image.string(), "--moving", reference_image.string(),
+                                       "--labels", reference_truth.string(), "--out", (c.dir / "elastix").string(),
+                                       "--grid-voxels", std::to_string(kElastixGridVoxels)},
+                                      c.dir / "elastix_atlas.out", c.dir / "elastix_atlas.err", false);
+    try {
+      row.record = json::parse(read_text(c.dir / "elastix_atlas.out"));
+    } catch (const json::exception&) {
+      row.record = json::object();
+    }
+    row.registration_seconds = number_or_nan(row.record, "registration_seconds");
+    row.transformix_seconds = number_or_nan(row.record, "transformix_seconds");
+    row.fixed_spacing_mm = numbers(row.record, "fixed_spacing_mm");
+    row.grid_spacing_mm = numbers(row.record, "bspline_grid_spacing_mm");
+    if (r.exit_code != 0) {
+      row.error = row.record.value("error", tail(read_text(c.dir / "elastix_atlas.err"), 300));
+    } else {
+      // The synth truth holds the structure (or its modelled part) as label 1.
+      const std::string warped = row.record["warped_labels"].get<std::string>();
+      const ChildResult e = mrsnake_cmd({"evaluate", "--seg", warped, "--truth", c.truth.string(), "--label", "1", "--json"},
+                                        c.dir, "evaluate-elastix", false);
+      if (e.exit_code == 0)
+        row.scores = scores_from(json::parse(read_text(c.dir / "evaluate-elastix.out")));
+      else
+        row.error = "evaluate: " + tail(read_text(c.dir / "evaluate-elastix.err"), 300);
+    }
+    if (row.error.empty())
+      std::printf(": Dice %.4f, registration %.1f s\n", row.scores.dice, row.registration_seconds);
+    else
+      std::printf(" FAILED (exit %d): %s\n", r.exit_code, row.error.c_str());
+    elastix_rows.push_back(row);
+  }
+
   /// The snake, its initial surface, and both ITK level sets from that surface.
   void run_case(const Case& c) {
     if (!only.empty() && c.name.find(only) == std::string::npos) return;
@@ -241,7 +384,7 @@ struct Bench {
     seg_args.insert(seg_args.end(), init_args.begin(), init_args.end());
     const ChildResult r = mrsnake_cmd(seg_args, c.dir, "segment", false);
     json report;
-    Row snake = make_row(c.name, primary_init.empty() ? "mrsnake" : "mrsnake --init " + primary_init);
+    Row snake = make_row(c.name, primary_method());
     if (r.exit_code == 0) {
       report = json::parse(read_text(seg / "report.json"));
       snake.seconds = report["compute_seconds"].get<double>();
@@ -421,6 +564,98 @@ struct Bench {
                   num(r.register_seconds, "%.3f").c_str(), r.registration.c_str());
   }
 
+  /// Real data: the snake's primary run beside single-atlas elastix, per case and on average.
+  void print_elastix_table() const {
+    std::printf("\nmrsnake (%s, the default) against single-atlas elastix:\n", elastix_rival.c_str());
+    if (!elastix_skipped.empty()) std::printf("  elastix column skipped: %s\n", elastix_skipped.c_str());
+    if (!elastix_rows.empty()) {
+      std::printf("  elastix: the reference image (the one the model was built from; moving) registered to the case's image\n"
+                  "  (fixed), affine then B-spline, Mattes mutual information, 4 resolutions, 250 / 500 iterations per\n"
+                  "  resolution, 2048 random samples, one thread (bench/elastix_atlas: the parameters of bench/cross_subject);\n"
+                  "  the B-spline grid is FinalGridSpacingInVoxels %d:", kElastixGridVoxels);
+      std::map<std::string, std::vector<const ElastixRow*>> by_dataset;
+      for (const ElastixRow& e : elastix_rows) by_dataset[e.dataset].push_back(&e);
+      bool first = true;
+      for (const auto& [dataset, list] : by_dataset) {
+        const std::vector<double>& mm = list.front()->fixed_spacing_mm;
+        std::vector<double> grid(3, 0.0);
+        int laid = 0;
+        for (const ElastixRow* e : list)
+          if (e->grid_spacing_mm.size() == 3) {
+            for (int d = 0; d < 3; ++d) grid[d] += e->grid_spacing_mm[d];
+            ++laid;
+          }
+        std::vector<double> nominal;
+        for (double v : mm) nominal.push_back(kElastixGridVoxels * v);
+        std::printf("%s %s at %s's %s voxels", first ? "" : ";", spacing_text(nominal).c_str(), dataset.c_str(),
+                    spacing_text(mm).c_str());
+        if (laid > 0)
+          std::printf(" (as elastix laid it on the box after the affine: mean %s×%s×%s mm)", cell(grid[0] / laid, "%.1f").c_str(),
+                      cell(grid[1] / laid, "%.1f").c_str(), cell(grid[2] / laid, "%.1f").c_str());
+        first = false;
+      }
+      std::printf(".\n  transformix warps the reference truth (the structure's label; for a two-part label only the modelled\n"
+                  "  part, as synth takes it) with nearest neighbour; `mrsnake evaluate` scores it against the case's truth.\n"
+                  "  elastix s: the registration's wall seconds (transformix not included); mrsnake compute s: after\n"
+                  "  loading (report.json); wall s: the whole segment process. Distances in mm.\n");
+    }
+    std::printf("\n| case | mrsnake Dice | ASSD | HD95 | compute s | wall s | elastix Dice | ASSD | HD95 | elastix s |\n"
+                "|---|---|---|---|---|---|---|---|---|---|\n");
+    std::map<std::string, const ElastixRow*> elastix_of;
+    for (const ElastixRow& e : elastix_rows) elastix_of[e.case_name] = &e;
+    ColumnMean m_dice, m_assd, m_hd95, m_compute, m_wall, e_dice, e_assd, e_hd95, e_seconds;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    int n = 0;
+    for (const Row& r : rows) {
+      if (r.method != elastix_rival) continue;
+      const ElastixRow* e = elastix_of.count(r.case_name) ? elastix_of.at(r.case_name) : nullptr;
+      const double ed = e ? e->scores.dice : nan, ea = e ? e->scores.assd_mm : nan, eh = e ? e->scores.hd95_mm : nan;
+      const double es = e ? e->registration_seconds : nan;
+      std::printf("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", r.case_name.c_str(),
+                  cell(r.scores.dice, "%.4f").c_str(), cell(r.scores.assd_mm, "%.3f").c_str(),
+                  cell(r.scores.hd95_mm, "%.3f").c_str(), cell(r.seconds, "%.3f").c_str(),
+                  cell(r.wall_seconds, "%.2f").c_str(), cell(ed, "%.4f").c_str(), cell(ea, "%.3f").c_str(),
+                  cell(eh, "%.3f").c_str(), cell(es, "%.1f").c_str());
+      m_dice.add(r.scores.dice);
+      m_assd.add(r.scores.assd_mm);
+      m_hd95.add(r.scores.hd95_mm);
+      m_compute.add(r.seconds);
+      m_wall.add(r.wall_seconds);
+      e_dice.add(ed);
+      e_assd.add(ea);
+      e_hd95.add(eh);
+      e_seconds.add(es);
+      ++n;
+    }
+    std::printf("| mean of %d | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", n, m_dice.text("%.4f").c_str(),
+                m_assd.text("%.3f").c_str(), m_hd95.text("%.3f").c_str(), m_compute.text("%.3f").c_str(),
+                m_wall.text("%.2f").c_str(), e_dice.text("%.4f").c_str(), e_assd.text("%.3f").c_str(),
+                e_hd95.text("%.3f").c_str(), e_seconds.text("%.1f").c_str());
+    for (const ElastixRow& e : elastix_rows)
+      if (!e.error.empty()) std::printf("elastix failed on %s (scored Dice 0): %s\n", e.case_name.c_str(), e.error.c_str());
+  }
+
+  json elastix_rows_json() const {
+    json out = json::array();
+    const auto val = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+    for (const ElastixRow& e : elastix_rows) {
+      json s;
+      to_json(s, e.scores);
+      out.push_back({{"case", e.case_name},
+                     {"dataset", e.dataset},
+                     {"dice", val(e.scores.dice)},
+                     {"assd_mm", val(e.scores.assd_mm)},
+                     {"hd95_mm", val(e.scores.hd95_mm)},
+                     {"registration_seconds", val(e.registration_seconds)},
+                     {"transformix_seconds", val(e.transformix_seconds)},
+                     {"grid_voxels", kElastixGridVoxels},
+                     {"error", e.error.empty() ? json(nullptr) : json(e.error)},
+                     {"scores", s},
+                     {"elastix_atlas", e.record}});
+    }
+    return out;
+  }
+
   json init_rows_json() const {
     json out = json::array();
     const auto val = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
@@ -598,6 +833,11 @@ void real_cases(Bench& b, const fs::path& data) {
     c.image = c.dir / "case" / "image.nii.gz";
     c.truth = c.dir / "case" / "truth.nii.gz";
     b.run_case(c);
+    if (!b.elastix_atlas.empty() && (b.only.empty() || c.name.find(b.only) != std::string::npos)) {
+      const fs::path reference_truth = c.dir / "reference-truth.nii.gz";
+      Bench::write_reference_truth(v / s.labels, s.label, s.component, reference_truth);
+      b.run_elastix(c, s.image.substr(0, s.image.find('.')), v / s.image, reference_truth);
+    }
   }
 }
 
@@ -605,7 +845,7 @@ void real_cases(Bench& b, const fs::path& data) {
 
 int main(int argc, char** argv) {
   bool quick = false, keep = false;
-  std::string real, work, json_out = "bench_segment.json", only, gac;
+  std::string real, work, json_out = "bench_segment.json", only, gac, elastix_atlas;
   std::string mrsnake_bin;
   if (const char* env = std::getenv("MRSNAKE_BIN")) mrsnake_bin = env;
   for (int i = 1; i < argc; ++i) {
@@ -625,10 +865,12 @@ int main(int argc, char** argv) {
     else if (a == "--json") json_out = value();
     else if (a == "--only") only = value();
     else if (a == "--gac") gac = value();
+    else if (a == "--elastix-atlas") elastix_atlas = value();
     else {
       std::fprintf(stderr,
                    "usage: bench_segment [--quick] [--real DATA_DIR] [--mrsnake BIN] [--work DIR] [--json OUT] [--keep]\n"
-                   "                     [--only CASE_SUBSTRING] [--gac PROPAGATION,CURVATURE,ADVECTION[,SIGMA_MM,BETA_FRACTION,ALPHA_DIVISOR]]\n");
+                   "                     [--only CASE_SUBSTRING] [--gac PROPAGATION,CURVATURE,ADVECTION[,SIGMA_MM,BETA_FRACTION,ALPHA_DIVISOR]]\n"
+                   "                     [--elastix-atlas SCRIPT]\n");
       return a == "--help" || a == "-h" ? 0 : 2;
     }
   }
@@ -662,6 +904,18 @@ int main(int argc, char** argv) {
   std::printf("bench_segment: %s, work folder %s; models %s an appearance (build-model --image)\n",
               real.empty() ? (quick ? "synthetic 128³ (quick)" : "synthetic 128³ and 256³") : "real data",
               b.work.c_str(), b.model_takes_image ? "with" : "without");
+  if (!real.empty()) {
+    // Single-atlas elastix beside the snake: bench/elastix_atlas (next to this source file
+    // unless given), which needs elastix and transformix.
+    if (elastix_atlas.empty()) elastix_atlas = (fs::path(__FILE__).parent_path() / "elastix_atlas").string();
+    if (!on_path("elastix") || !on_path("transformix"))
+      b.elastix_skipped = "elastix or transformix is not on PATH (apt-get install elastix)";
+    else if (access(elastix_atlas.c_str(), X_OK) != 0)
+      b.elastix_skipped = "no executable " + elastix_atlas + " (give --elastix-atlas)";
+    else
+      b.elastix_atlas = fs::absolute(elastix_atlas).string();
+    if (!b.elastix_skipped.empty()) std::printf("elastix column skipped: %s\n", b.elastix_skipped.c_str());
+  }
   const auto t0 = Clock::now();
   try {
     if (real.empty()) {
@@ -676,9 +930,11 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_segment: %s\n", e.what());
     b.print_table();
+    if (!real.empty()) b.print_elastix_table();
     return 1;
   }
   b.print_table();
+  if (!real.empty()) b.print_elastix_table();
   const json targets = b.targets();
   std::printf("\ntotal %.0f s\n", seconds_since(t0));
   json out{{"benchmark", real.empty() ? "synthetic" : "real"},
@@ -687,6 +943,8 @@ int main(int argc, char** argv) {
            {"threads", 1},
            {"rows", b.to_json_rows()},
            {"initializations", b.init_rows_json()},
+           {"elastix", b.elastix_rows_json()},
+           {"elastix_skipped", b.elastix_skipped.empty() ? json(nullptr) : json(b.elastix_skipped)},
            {"targets", targets},
            {"total_seconds", seconds_since(t0)}};
   write_text_file_atomically(json_out, out.dump(2) + "\n");
