@@ -52,7 +52,7 @@ void add_build_model_command(CLI::App& app) {
                                  "semi-regular remeshing, lifting-wavelet analysis");
   struct Args {
     std::string labels, output, predict = "butterfly", image;
-    int label = 1, levels = 0, faces = 0, smooth = 20, close_tunnels = 0, component = 0;
+    int label = 1, levels = 0, faces = 0, smooth = 20, close_tunnels = 3, component = 0;
     double mc_spacing = -1;  // derived from the structure: see --mc-spacing
     bool full_report = false, json = false, compare_unrelaxed = false, allow_poor_fit = false;
     double reference_margin_mm = -1;  // derived from the structure: see --reference-margin
@@ -97,7 +97,8 @@ void add_build_model_command(CLI::App& app) {
       ->check(CLI::Range(0.0, 100.0));
   cmd->add_option("--close-tunnels", a->close_tunnels,
                   "If the label's surface is not genus 0, close the label with radii up to this many voxels until it "
-                  "is (as 'mrsnake mc --close-tunnels'); 0 = no repair")
+                  "is (as 'mrsnake mc --close-tunnels'; default 3: a label's stray tunnels of a voxel or two are "
+                  "closed with a warning, and the fit check refuses a closing that changed the shape); 0 = no repair")
       ->check(CLI::Range(0, 20));
   cmd->add_option("--component", a->component,
                   "Model only the label's K-th largest connected part (1 = the largest), e.g. one of a left and a right "

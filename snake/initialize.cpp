@@ -227,10 +227,27 @@ Similarity fit_similarity_to_targets(RowMatrixX3d& V, const RowMatrixX3i& F, con
   Similarity total;
   RowMatrixX3d N;
   const int n = static_cast<int>(V.rows());
+  // The pose whose search matched best so far: a fit on weak or ambiguous evidence (another
+  // animal's profiles, a thin structure) drifts on while its matches get worse.
+  Similarity best_total;
+  RowMatrixX3d best_V = V;
+  double best_cost = std::numeric_limits<double>::infinity();
+  int since_best = 0;
+  bool stopped_worse = false;
   int it = 0;
   for (; it < options.iterations; ++it) {
     vertex_normals(V, F, N);
     const SearchResult found = search(V, N);
+    const double cost = found.costs.mean();
+    if (cost < best_cost) {
+      best_cost = cost;
+      best_total = total;
+      best_V = V;
+      since_best = 0;
+    } else if (options.patience > 0 && ++since_best >= options.patience) {
+      stopped_worse = true;  // V was searched and matched worse than best_V
+      break;
+    }
     // Keep the best-matching (1 − trim) of the vertices.
     std::vector<int> order(n);
     std::iota(order.begin(), order.end(), 0);
@@ -258,6 +275,17 @@ Similarity fit_similarity_to_targets(RowMatrixX3d& V, const RowMatrixX3i& F, con
     if (motion < options.tolerance_mm) {
       ++it;
       break;
+    }
+  }
+  if (options.patience > 0 && std::isfinite(best_cost)) {
+    // Otherwise the last pose has not been searched yet: judge it too.
+    if (!stopped_worse) {
+      vertex_normals(V, F, N);
+      stopped_worse = !(search(V, N).costs.mean() < best_cost);
+    }
+    if (stopped_worse) {
+      V = best_V;
+      total = best_total;
     }
   }
   if (iterations_done) *iterations_done = it;

@@ -86,6 +86,9 @@ struct TargetFitOptions {
   /// from SegmentOptions::fit_tolerance_voxels and the image's voxels.
   double tolerance_mm = 0.01;
   double trim_fraction = 0.2;  ///< drop the worst-matching fraction of vertices each iteration
+  /// Stop once the mean search cost has not improved for this many iterations, and return
+  /// the pose with the lowest cost seen (0: run on and return the last pose).
+  int patience = 0;
 };
 
 /// Fits a similarity of the whole mesh to its search targets x + o·n, repeatedly (a rigid

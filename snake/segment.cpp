@@ -361,6 +361,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     (void)step;
     TargetFitOptions fit_options = options.fit;
     fit_options.tolerance_mm = options.fit_tolerance_voxels * spacings[0];
+    if (registered) fit_options.patience = options.fit_patience_after_registration;
     double best_cost = std::numeric_limits<double>::infinity();
     for (const auto& [start, start_name] : starts) {
       RowMatrixX3d W = start.apply(model.levels[jf]);

@@ -229,11 +229,15 @@ TEST(BuildModelCli, CloseTunnelsMakesAGenusOneLabelModelable) {
   const std::string model = (dir / "torus.model").string();
 
   // Refused before the remeshing, with the flag that repairs it.
-  const auto refused = run_mrsnake("-q build-model --labels " + labels + " --label 4 -o " + model + " --faces 2048");
+  const auto refused =
+      run_mrsnake("-q build-model --labels " + labels + " --label 4 -o " + model + " --faces 2048 --close-tunnels 0");
   EXPECT_EQ(refused.exit_code, 3) << refused.output;
   EXPECT_NE(refused.output.find("genus-1 surface (tunnels through it), but a model needs genus 0; add --close-tunnels 3 "),
             std::string::npos)
       << refused.output;
+  // The default closes tunnels up to 3 voxels: this hole is wider, and it says so.
+  expect_refused("--labels " + labels + " --label 4 -o " + model + " --faces 2048", 3,
+                 "a closing of radius up to 3 voxels did not remove them: try a larger --close-tunnels", model);
   EXPECT_FALSE(std::filesystem::exists(model));
   // Too small a radius leaves the tunnel open: still refused, with a hint.
   expect_refused("--labels " + labels + " --label 4 -o " + model + " --faces 2048 --close-tunnels 1", 3,
