@@ -74,7 +74,7 @@ void add_build_model_command(CLI::App& app) {
   cmd->add_option("-o,--output", a->output, "Output model folder (replaced if it is already a model)")->required();
   auto* levels = cmd->add_option("--levels", a->levels, "Number of levels L (1:4 splits of the base mesh)")->check(CLI::Range(1, 10));
   auto* faces = cmd->add_option("--faces", a->faces,
-                                "Wanted face count of the finest level (default: triangles with edges of the surface's "
+                                "Wanted face count of the finest level (default: triangles with edges of half the surface's "
                                 "sampling length, the marching-cubes spacing or the finest voxel, 1024 to 32768)")
                     ->check(CLI::Range(16, 50000000));
   levels->excludes(faces);
@@ -118,7 +118,7 @@ void add_build_model_command(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "edges", "labels"}))
       ->needs(image_option);
   cmd->add_option("--reference-margin", a->reference_margin_mm,
-                  "Margin (mm) of the stored reference image crop around the organ (with --image; default 4 "
+                  "Margin (mm) of the stored reference image crop around the organ (with --image; default 6 "
                   "equivalent radii of the structure)")
       ->check(CLI::Range(0.0, 1000.0));
   cmd->add_flag("--allow-poor-fit", a->allow_poor_fit,

@@ -49,7 +49,8 @@ int default_face_count(const TriMesh& surface, double sampling_mm, int min_faces
                           c = surface.V.row(surface.F(f, 2));
     area += 0.5 * (b - a).cross(c - a).norm();
   }
-  const double triangle_area = std::sqrt(3.0) / 4.0 * sampling_mm * sampling_mm;
+  const double edge = 0.5 * sampling_mm;
+  const double triangle_area = std::sqrt(3.0) / 4.0 * edge * edge;
   const double faces = area / triangle_area;
   if (!std::isfinite(faces)) return max_faces;
   return static_cast<int>(std::clamp(std::lround(faces), static_cast<long>(min_faces), static_cast<long>(max_faces)));
