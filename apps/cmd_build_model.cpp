@@ -42,7 +42,7 @@ std::string poor_fit_message(const LabelFit& fit, const StructureScale& scale, d
     cause = "; the label may be too thin or ragged for a closed genus-0 model: check it with 'mrsnake mc', try "
             "--mc-spacing 0 or more --faces";
   }
-  return buf + cause + ", or give --allow-poor-fit to keep it";
+  return buf + cause;
 }
 }  // namespace
 
@@ -212,7 +212,8 @@ void add_build_model_command(CLI::App& app) {
     const LabelFit fit = measure_label_fit(hierarchy.mesh(hierarchy.connectivity.levels()),
                                            parts_dropped ? keep_label_part(labels, a->label, 1) : labels, a->label);
     if (fit.dice < kMinLabelFitDice && !a->allow_poor_fit)
-      throw AlgorithmError(poor_fit_message(fit, scale, mc_spacing, a->mc_spacing >= 0));
+      throw AlgorithmError(poor_fit_message(fit, scale, mc_spacing, a->mc_spacing >= 0) +
+                           ", or give --allow-poor-fit to keep it");
     if (fit.dice < kMinLabelFitDice) warn(poor_fit_message(fit, scale, mc_spacing, a->mc_spacing >= 0));
     lap("label_fit");
 
