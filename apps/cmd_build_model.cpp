@@ -26,23 +26,64 @@
 namespace mrsnake::cli {
 
 namespace {
+// What the user chose of the options that shape the surface, for the poor-fit message.
+struct SurfaceChoices {
+  double mc_spacing = 0;
+  bool spacing_given = false, faces_given = false;
+  int closing_radius = 0;  // the tunnel closing applied, in voxels (0: none)
+};
+
 // Why a model lost its organ, and what to type about it.
-std::string poor_fit_message(const LabelFit& fit, const StructureScale& scale, double mc_spacing, bool spacing_given) {
-  char buf[256];
+std::string poor_fit_message(const LabelFit& fit, const StructureScale& scale, const SurfaceChoices& c) {
+  char buf[512];
   std::snprintf(buf, sizeof buf,
                 "the model's finest level covers its label with Dice %.3f (volume %+.0f %%, below the %.2f accepted)",
                 fit.dice, 100.0 * (fit.volume_ratio - 1.0), kMinLabelFitDice);
   std::string cause;
-  if (mc_spacing > 0 && spacing_given) {
-    char c[200];
-    std::snprintf(c, sizeof c, "; the marching-cubes spacing %.3g mm is coarse for a structure of radius %.3g mm: give "
-                  "a smaller --mc-spacing (e.g. %.3g)", mc_spacing, scale.equivalent_radius_mm, scale.finest_voxel_mm);
-    cause = c;
+  if (c.closing_radius > 0) {
+    cause = "; closing the label's tunnels (radius " + std::to_string(c.closing_radius) +
+            " voxels) changed its shape: fill the tunnels in the label volume, or give --close-tunnels 0 to see them";
+  } else if (c.mc_spacing > 0 && c.spacing_given) {
+    char text[200];
+    std::snprintf(text, sizeof text, "; the marching-cubes spacing %.3g mm is coarse for a structure of radius %.3g mm: "
+                  "give a smaller --mc-spacing (e.g. %.3g)", c.mc_spacing, scale.equivalent_radius_mm,
+                  scale.finest_voxel_mm);
+    cause = text;
   } else {
-    cause = "; the label may be too thin or ragged for a closed genus-0 model: check it with 'mrsnake mc', try "
-            "--mc-spacing 0 or more --faces";
+    cause = "; the label may be too thin or ragged for a closed genus-0 model: check it with 'mrsnake mc'";
+    if (!c.spacing_given) cause += ", try --mc-spacing 0";
+    if (!c.faces_given) cause += ", or more --faces";
   }
   return buf + cause;
+}
+
+// The finest level against the label it came from: the label as modelled (its part K with
+// --component), and, when other parts were dropped, the better of the label and its two
+// largest parts (the surface kept is the largest by faces, which need not be the largest by
+// voxels; a tunnel closing may have joined two parts).
+LabelFit fit_to_source(const TriMesh& finest, const Volume& labels, int label, bool parts_dropped) {
+  LabelFit best = measure_label_fit(finest, labels, label);
+  for (int part = 1; parts_dropped && part <= 2; ++part) {
+    try {
+      const LabelFit f = measure_label_fit(finest, keep_label_part(labels, label, part), label);
+      if (f.dice > best.dice) best = f;
+    } catch (const InputError&) {  // fewer parts than that
+      break;
+    }
+  }
+  return best;
+}
+
+// model.json's `scale`: the structure's size, every default derived from it, the fit.
+nlohmann::json scale_record(const StructureScale& scale, double mc_spacing, int smoothing, int finest_faces,
+                            const std::optional<double>& reference_margin_mm, const LabelFit& fit) {
+  nlohmann::json j = scale;
+  j["marching_cubes_spacing_mm"] = mc_spacing;
+  j["smoothing_iterations"] = smoothing;
+  j["faces"] = finest_faces;
+  j["reference_margin_mm"] = reference_margin_mm ? nlohmann::json(*reference_margin_mm) : nlohmann::json();
+  j["fit_to_label"] = fit;
+  return j;
 }
 }  // namespace
 
@@ -131,7 +172,9 @@ void add_build_model_command(CLI::App& app) {
   cmd->footer(
       "Example: mrsnake build-model --labels liver-labels.nii.gz --label 255 --image liver.nii.gz -o liver.model "
       "--faces 32768\n"
-      "A label with tunnels (genus > 0): add --close-tunnels 3, e.g. the liver of abdomen-ct-small-seg.nii.gz (label 5).");
+      "Every default length follows the structure's size and voxels (model.json 'scale' records them). A label\n"
+      "with tunnels of up to 3 voxels (genus > 0) is closed by default, e.g. the liver of abdomen-ct-small-seg.nii.gz\n"
+      "(label 5); wider ones need a larger --close-tunnels.");
   cmd->callback([a, smooth] {
     using clock = std::chrono::steady_clock;
     const auto progress = terminal_progress();
@@ -166,7 +209,7 @@ void add_build_model_command(CLI::App& app) {
           " surface (tunnels through it), but a model needs genus 0; " +
           (a->close_tunnels > 0 ? "a closing of radius up to " + std::to_string(a->close_tunnels) +
                                       " voxels did not remove them: try a larger --close-tunnels"
-                                : std::string("add --close-tunnels 3 (a morphological closing of radius up to 3 voxels)")) +
+                                : std::string("drop --close-tunnels 0 (the default closes them up to 3 voxels)")) +
           ", or fill them in the label volume");
     if (!surface.dropped_component_faces.empty())
       warn("label " + std::to_string(a->label) + " has " + std::to_string(surface.components_found) +
@@ -206,15 +249,14 @@ void add_build_model_command(CLI::App& app) {
     lap("analysis");
 
     // A model that has lost its organ is refused here, before anything is written.
-    // (Against the part the surface came from when the label's other parts were dropped, as
-    // the warning above said.)
-    const bool parts_dropped = !surface.dropped_component_faces.empty() && a->component == 0;
-    const LabelFit fit = measure_label_fit(hierarchy.mesh(hierarchy.connectivity.levels()),
-                                           parts_dropped ? keep_label_part(labels, a->label, 1) : labels, a->label);
-    if (fit.dice < kMinLabelFitDice && !a->allow_poor_fit)
-      throw AlgorithmError(poor_fit_message(fit, scale, mc_spacing, a->mc_spacing >= 0) +
-                           ", or give --allow-poor-fit to keep it");
-    if (fit.dice < kMinLabelFitDice) warn(poor_fit_message(fit, scale, mc_spacing, a->mc_spacing >= 0));
+    const LabelFit fit = fit_to_source(hierarchy.mesh(hierarchy.connectivity.levels()), labels, a->label,
+                                       !surface.dropped_component_faces.empty() && a->component == 0);
+    if (!(fit.dice >= kMinLabelFitDice)) {
+      const SurfaceChoices choices{mc_spacing, a->mc_spacing >= 0, a->faces > 0 || a->levels > 0, surface.closing_radius};
+      if (!a->allow_poor_fit)
+        throw AlgorithmError(poor_fit_message(fit, scale, choices) + ", or give --allow-poor-fit to keep it");
+      warn(poor_fit_message(fit, scale, choices));
+    }
     lap("label_fit");
 
     const double reference_margin_mm =
@@ -249,12 +291,8 @@ void add_build_model_command(CLI::App& app) {
                                  {"smoothing_iterations", smoothing},
                                  {"faces", surface.mesh.num_faces()}};
     model.remesh_quality = quality;
-    model.scale = scale;
-    model.scale["marching_cubes_spacing_mm"] = mc_spacing;
-    model.scale["smoothing_iterations"] = smoothing;
-    model.scale["faces"] = faces;
-    model.scale["reference_margin_mm"] = a->image.empty() ? nlohmann::json() : nlohmann::json(reference_margin_mm);
-    model.scale["fit_to_label"] = fit;
+    model.scale = scale_record(scale, mc_spacing, smoothing, static_cast<int>(hierarchy.connectivity.faces.back().rows()),
+                               a->image.empty() ? std::nullopt : std::optional<double>(reference_margin_mm), fit);
     // The manifest records every stage up to the write; the write's own time is printed.
     model.timings = timings;
 

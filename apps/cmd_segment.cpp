@@ -67,8 +67,9 @@ void write_segment_page(const std::filesystem::path& path, const std::string& im
   mrsnake::reports::write_segment_report(path.string(), page);
 }
 
-// A result whose volume is off the model's by more than this factor, either way, is flagged:
-// between the four mice the same structure's volume differs by at most 1.3×.
+// A result whose volume is off the model's by more than this factor, either way, is flagged.
+// A heuristic: between the four mice the same structure's volume differs by at most 1.3×;
+// organs that vary more between subjects will raise it more often.
 constexpr double kMaxVolumeFactor = 1.5;
 
 // report.json's verdict on a result: "suspect" (bool) and "reason" (empty when not), from
@@ -82,7 +83,9 @@ void flag_doubtful_result(nlohmann::json& rep, const SnakeModel& model) {
   rep["model_volume_mm3"] = model_volume;
   rep["volume_ratio_to_model"] = ratio;
   std::vector<std::string> reasons;
-  if (!(ratio <= kMaxVolumeFactor && ratio >= 1.0 / kMaxVolumeFactor)) {
+  if (!(model_volume > 0)) {
+    reasons.emplace_back("the model's finest level encloses no volume; rebuild the model");
+  } else if (!(ratio <= kMaxVolumeFactor && ratio >= 1.0 / kMaxVolumeFactor)) {
     char text[160];
     std::snprintf(text, sizeof text, "the volume is %.2f times the model's (accepted: %.2f to %.2f)", ratio,
                   1.0 / kMaxVolumeFactor, kMaxVolumeFactor);

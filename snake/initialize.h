@@ -94,7 +94,10 @@ struct TargetFitOptions {
 /// Fits a similarity of the whole mesh to its search targets x + o·n, repeatedly (a rigid
 /// or similarity "active shape" step): each iteration searches, solves the Umeyama
 /// least-squares similarity from the current vertices to their targets (trimmed), and applies it.
-/// Returns the total similarity; V is updated.
+/// Returns the total similarity; V is updated. With options.patience > 0 the pose returned
+/// (and left in V) is the one whose search had the lowest mean cost, the last pose searched
+/// once more to judge it; *iterations_done counts every iteration run, also those past it.
+/// \throw nothing beyond what `search` throws.
 Similarity fit_similarity_to_targets(RowMatrixX3d& V, const RowMatrixX3i& F, const ExternalSearch& search,
                                      const TargetFitOptions& options = {}, int* iterations_done = nullptr);
 

@@ -10,6 +10,7 @@
 
 namespace mrsnake {
 
+/// The finest level against its label, on the label's grid.
 struct LabelFit {
   double dice = 0;
   double model_volume_mm3 = 0;  ///< of the rasterized level
@@ -19,7 +20,8 @@ struct LabelFit {
 
 /// Rasterizes `surface` (closed, in the labels' physical space) on the grid of `labels` and
 /// scores it against the voxels equal to `label`.
-/// \pre surface is closed.
+/// \pre surface is closed; labels has data of its size.
+/// \throw nothing beyond std::bad_alloc.
 LabelFit measure_label_fit(const TriMesh& surface, const Volume& labels, int label);
 
 /// The smallest Dice build-model accepts without --allow-poor-fit.

@@ -39,7 +39,9 @@ StructureScale measure_structure(const Volume& labels, int label) {
 
 double default_marching_cubes_spacing(const StructureScale& scale) {
   const double wanted = scale.equivalent_radius_mm / kCellsPerRadius;
-  return scale.finest_voxel_mm < wanted ? wanted : 0.0;
+  if (scale.finest_voxel_mm < wanted) return wanted;
+  if (scale.largest_voxel_mm > 1.5 * scale.finest_voxel_mm) return scale.finest_voxel_mm;
+  return 0.0;
 }
 
 int default_face_count(const TriMesh& surface, double sampling_mm, int min_faces, int max_faces) {
@@ -53,7 +55,9 @@ int default_face_count(const TriMesh& surface, double sampling_mm, int min_faces
   const double triangle_area = std::sqrt(3.0) / 4.0 * edge * edge;
   const double faces = area / triangle_area;
   if (!std::isfinite(faces)) return max_faces;
-  return static_cast<int>(std::clamp(std::lround(faces), static_cast<long>(min_faces), static_cast<long>(max_faces)));
+  // Clamped before the rounding: a huge count does not overflow the integer.
+  return static_cast<int>(
+      std::lround(std::clamp(faces, static_cast<double>(min_faces), static_cast<double>(max_faces))));
 }
 
 double default_reference_margin(const StructureScale& scale) {

@@ -13,13 +13,16 @@
 
 namespace mrsnake {
 
-/// What a label volume says about the size of one structure.
+/// What a label volume says about the size of one structure (all voxels of the label: every
+/// connected part of it).
 struct StructureScale {
   double finest_voxel_mm = 0;          ///< the smallest voxel side of the label volume
   double largest_voxel_mm = 0;         ///< the largest voxel side
   double volume_mm3 = 0;               ///< voxels of the label × voxel volume
   double equivalent_radius_mm = 0;     ///< radius of the sphere of that volume
-  std::array<double, 3> extent_mm{0, 0, 0};  ///< bounding box of the label's voxels, physical axes
+  /// Bounding box of the label's voxel centres along the physical axes, grown by the largest
+  /// voxel side.
+  std::array<double, 3> extent_mm{0, 0, 0};
 };
 
 /// Measures the voxels equal to `label` (volume and extent 0 when there is none).
@@ -32,7 +35,10 @@ StructureScale measure_structure(const Volume& labels, int label);
 constexpr double kCellsPerRadius = 60.0;
 
 /// The marching-cubes spacing build-model uses by default: radius / kCellsPerRadius when the
-/// label's voxels are finer than that, else 0 (the voxels' own surface).
+/// label's finest voxel side is below that; else, for voxels longer than 1.5 times their
+/// finest side along some axis (thick slices), the finest side, so that the surface has no
+/// slice staircase; else 0 (the voxels' own surface).
+/// \pre scale comes from measure_structure (0 for an empty label gives 0).
 double default_marching_cubes_spacing(const StructureScale& scale);
 
 /// The default finest face count: equilateral triangles whose edge is half the surface's
@@ -42,7 +48,8 @@ double default_marching_cubes_spacing(const StructureScale& scale);
 /// (Across the mice, edges of half a voxel rather than one raised the two globus pallidi,
 /// 1.7 mm³, from Dice 0.870 and 0.885 to 0.873 and 0.887, and changed the other structures
 /// by at most 0.001; the cap keeps a large organ's model within the snake's budget.)
-/// \pre sampling_mm > 0.
+/// \pre sampling_mm > 0 (otherwise max_faces).
+/// \throw nothing.
 int default_face_count(const TriMesh& surface, double sampling_mm, int min_faces = 1024, int max_faces = 32768);
 
 /// Margin, per side, of the reference image crop that segment registers: this many
@@ -52,6 +59,9 @@ int default_face_count(const TriMesh& surface, double sampling_mm, int min_faces
 /// same-subject cases the mean rose by 0.0006. Smaller crops, 1.5-3 radii, lost some cases
 /// altogether.)
 constexpr double kReferenceMarginRadii = 6.0;
+
+/// The default reference-crop margin per side: kReferenceMarginRadii equivalent radii (mm).
+/// \throw nothing.
 double default_reference_margin(const StructureScale& scale);
 
 /// Keys: finest_voxel_mm, largest_voxel_mm, volume_mm3, equivalent_radius_mm, extent_mm.

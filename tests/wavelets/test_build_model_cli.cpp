@@ -232,7 +232,7 @@ TEST(BuildModelCli, CloseTunnelsMakesAGenusOneLabelModelable) {
   const auto refused =
       run_mrsnake("-q build-model --labels " + labels + " --label 4 -o " + model + " --faces 2048 --close-tunnels 0");
   EXPECT_EQ(refused.exit_code, 3) << refused.output;
-  EXPECT_NE(refused.output.find("genus-1 surface (tunnels through it), but a model needs genus 0; add --close-tunnels 3 "),
+  EXPECT_NE(refused.output.find("genus-1 surface (tunnels through it), but a model needs genus 0; drop --close-tunnels 0 "),
             std::string::npos)
       << refused.output;
   // The default closes tunnels up to 3 voxels: this hole is wider, and it says so.
