@@ -6,7 +6,6 @@
 
 #include <nlohmann/json.hpp>
 
-
 namespace mrsnake {
 
 StructureScale measure_structure(const Volume& labels, int label) {
@@ -32,7 +31,7 @@ StructureScale measure_structure(const Volume& labels, int label) {
   if (count == 0) return s;  // the caller's surface extraction says which labels there are
   s.volume_mm3 = static_cast<double>(count) * labels.spacing[0] * labels.spacing[1] * labels.spacing[2];
   s.equivalent_radius_mm = std::cbrt(3.0 * s.volume_mm3 / (4.0 * M_PI));
-  // The voxel centres' box, grown by one voxel: a single voxel has the extent of a voxel.
+  // The voxel centres' box, grown by the largest voxel side: a single voxel has a voxel's extent.
   for (int a = 0; a < 3; ++a) s.extent_mm[a] = hi[a] - lo[a] + s.largest_voxel_mm;
   return s;
 }
