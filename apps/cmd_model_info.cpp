@@ -102,6 +102,25 @@ void add_model_info_command(CLI::App& app) {
           if (q.contains(key) && q[key].is_number()) std::cout << ' ' << key << ' ' << format("%.3g", q[key].get<double>());
         std::cout << '\n';
       }
+      if (model.scale.is_object()) {
+        // The structure's size and the defaults build-model derived from it (model.json "scale").
+        const nlohmann::json& sc = model.scale;
+        const auto number = [&sc](const char* key, const char* fmt) {
+          return sc.contains(key) && sc[key].is_number() ? format(fmt, sc[key].get<double>()) : std::string("-");
+        };
+        std::cout << "  structure         " << number("volume_mm3", "%.4g") << " mm3, equivalent radius "
+                  << number("equivalent_radius_mm", "%.3g") << " mm; marching cubes "
+                  << number("marching_cubes_spacing_mm", "%.3g") << " mm"
+                  << (sc.contains("reference_margin_mm") && sc["reference_margin_mm"].is_number()
+                          ? ", reference margin " + number("reference_margin_mm", "%.3g") + " mm"
+                          : std::string())
+                  << '\n';
+        if (sc.contains("fit_to_label") && sc["fit_to_label"].is_object()) {
+          const nlohmann::json& f = sc["fit_to_label"];
+          std::cout << "  fit to its label  Dice " << format("%.4f", f.value("dice", 0.0)) << ", volume ratio "
+                    << format("%.3f", f.value("volume_ratio", 0.0)) << '\n';
+        }
+      }
       if (!model.timings.empty()) {
         std::cout << "  timings (s)      ";
         for (const auto& [stage, s] : model.timings) std::cout << ' ' << stage << ' ' << format("%.3f", s);

@@ -376,5 +376,9 @@ TEST(BuildModelCli, AModelThatLostItsOrganIsRefusedUnlessAllowed) {
   const auto summary = nlohmann::json::parse(built.output);
   EXPECT_GT(summary["scale"]["fit_to_label"]["dice"].get<double>(), 0.95);
   EXPECT_NEAR(summary["scale"]["equivalent_radius_mm"].get<double>(), 1.8, 0.05);
+  // model-info shows the structure's size and the fit.
+  const auto info = run_mrsnake("model-info " + model);
+  EXPECT_NE(info.output.find("equivalent radius 1.8"), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("fit to its label  Dice "), std::string::npos) << info.output;
   std::filesystem::remove_all(dir);
 }
