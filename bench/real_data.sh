@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Real-data procedure of issue 6: for the liver (label 5) of abdomen-ct-small and the genus-0
+# Real-data procedure: for the liver (label 5) of abdomen-ct-small and the genus-0
 # brain structures of MRIcrop (labels 3, 4, 5, 8; the two parts of 6 and of 7 one at a time), build the model from the labels (tunnels of
 # the liver closed), make a new case with `mrsnake synth --from-image` (a known random pose
 # and deformation), segment it and score it against the synth truth; ITK's level sets run
