@@ -23,8 +23,7 @@ enum class ProfileCentre {
   /// below the label's rounding, and the segmentation deforms the level even when it is finer
   /// than the image (segment.h).
   edges,
-  /// Not recorded (appearance format 01: session 10's build-model already centred some
-  /// profiles on the edges without saying so); treated as labels.
+  /// Not recorded (appearance format 01, whose profiles may sit on either); treated as labels.
   unrecorded,
 };
 /// "labels", "edges" or "unrecorded".
