@@ -20,6 +20,7 @@
 #include "remesh/remesh.h"
 #include "snake/label_fit.h"
 #include "snake/model_bridge.h"
+#include "snake/rasterize.h"
 #include "snake/structure_scale.h"
 #include "wavelets/model_io.h"
 
@@ -62,10 +63,11 @@ std::string poor_fit_message(const LabelFit& fit, const StructureScale& scale, c
 // largest parts (the surface kept is the largest by faces, which need not be the largest by
 // voxels; a tunnel closing may have joined two parts).
 LabelFit fit_to_source(const TriMesh& finest, const Volume& labels, int label, bool parts_dropped) {
-  LabelFit best = measure_label_fit(finest, labels, label);
+  const Volume raster = rasterize_mesh(finest, labels, 1.0f);
+  LabelFit best = label_fit_of_raster(raster, labels, label);
   for (int part = 1; parts_dropped && part <= 2; ++part) {
     try {
-      const LabelFit f = measure_label_fit(finest, keep_label_part(labels, label, part), label);
+      const LabelFit f = label_fit_of_raster(raster, keep_label_part(labels, label, part), label);
       if (f.dice > best.dice) best = f;
     } catch (const InputError&) {  // fewer parts than that
       break;

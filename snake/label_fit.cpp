@@ -8,7 +8,10 @@
 namespace mrsnake {
 
 LabelFit measure_label_fit(const TriMesh& surface, const Volume& labels, int label) {
-  const Volume raster = rasterize_mesh(surface, labels, 1.0f);
+  return label_fit_of_raster(rasterize_mesh(surface, labels, 1.0f), labels, label);
+}
+
+LabelFit label_fit_of_raster(const Volume& raster, const Volume& labels, int label) {
   const SegmentationScores s = evaluate_segmentation(raster, labels, 1, label);
   LabelFit f;
   f.dice = s.dice;

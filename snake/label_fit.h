@@ -24,6 +24,12 @@ struct LabelFit {
 /// \throw nothing beyond std::bad_alloc.
 LabelFit measure_label_fit(const TriMesh& surface, const Volume& labels, int label);
 
+/// The same score from a surface already rasterized on the labels' grid (1 inside), so that
+/// one rasterization serves several references.
+/// \pre raster has the grid of labels.
+/// \throw nothing beyond std::bad_alloc.
+LabelFit label_fit_of_raster(const Volume& raster, const Volume& labels, int label);
+
 /// The smallest Dice build-model accepts without --allow-poor-fit.
 constexpr double kMinLabelFitDice = 0.90;
 
