@@ -31,11 +31,12 @@ void add_sphere_map_option(CLI::App& command, SphereMap& map) {
   command
       .add_option("--sphere-map", map,
                   "Closed surfaces: 'auto' (the default: halves from " + std::to_string(ParameterizationOptions{}.halves_from_faces) +
-                      " faces, punctured below), 'halves' (cut in two disks across a principal plane, one solve per core) "
-                      "or 'punctured' (one vertex removed, one solve)")
+                      " faces, punctured below, hierarchical where those fail), 'halves' (cut in two disks across a "
+                      "principal plane, one solve per core), 'punctured' (one vertex removed, one solve) or 'hierarchical' "
+                      "(coarse to fine from a tetrahedron: long protrusions keep their area)")
       ->transform(CLI::CheckedTransformer(std::map<std::string, SphereMap>{
-          {"auto", SphereMap::automatic}, {"halves", SphereMap::two_halves}, {"punctured", SphereMap::punctured}}))
-      ->option_text("auto|halves|punctured");
+          {"auto", SphereMap::automatic}, {"halves", SphereMap::two_halves}, {"punctured", SphereMap::punctured}, {"hierarchical", SphereMap::hierarchical}}))
+      ->option_text("auto|halves|punctured|hierarchical");
 }
 
 void add_fit_rounds_option(CLI::App& command, int& rounds) {

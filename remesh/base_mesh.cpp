@@ -60,10 +60,56 @@ void triangulate_samples(const Parameterization& param, const std::vector<bool>&
                          " vertices; the parameterization is too distorted for this base size (try another --faces)");
   if (const int flipped = count_flipped(base.domain, base.faces); flipped > 0)
     throw AlgorithmError("the base mesh has " + std::to_string(flipped) + " flipped triangles in the domain");
+  if (param.sphere_map == SphereMap::hierarchical) {
+    RowMatrixX3d X(m, 3);
+    for (int i = 0; i < m; ++i) X.row(i) = param.surface.V.row(base.samples[i]);
+    base.surface_flips += flip_toward_surface_delaunay(base.domain, X, base.faces);
+  }
   base.valence_flips += flip_toward_regular_valence(base.domain, base.faces, rim_min_triangles);
 }
 
 }  // namespace
+
+int flip_toward_surface_delaunay(const RowMatrixX3d& D, const RowMatrixX3d& X, RowMatrixX3i& F) {
+  const auto angle_at = [&](int apex, int a, int b) {
+    const Eigen::Vector3d u = X.row(a) - X.row(apex), w = X.row(b) - X.row(apex);
+    return std::atan2(u.cross(w).norm(), u.dot(w));
+  };
+  int flips = 0;
+  for (int pass = 0; pass < 100; ++pass) {
+    std::map<std::pair<int, int>, std::pair<int, int>> edge_faces;  // directed edge -> (face, corner opposite)
+    for (int f = 0; f < F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) edge_faces[{F(f, k), F(f, (k + 1) % 3)}] = {f, (k + 2) % 3};
+    std::vector<int> valence(D.rows(), 0);
+    for (const auto& [e, fc] : edge_faces) ++valence[e.first];
+    bool changed = false;
+    std::vector<bool> touched(F.rows(), false);
+    for (const auto& [e, fc] : edge_faces) {
+      const int a = e.first, b = e.second;
+      const auto twin = edge_faces.find({b, a});
+      if (a > b || twin == edge_faces.end()) continue;
+      const int f1 = fc.first, f2 = twin->second.first;
+      if (touched[f1] || touched[f2]) continue;
+      const int c = F(f1, fc.second), d = F(f2, twin->second.second);
+      if (c == d || edge_faces.count({c, d}) || edge_faces.count({d, c}) || valence[a] <= 3 || valence[b] <= 3) continue;
+      // The surface's Delaunay condition: the two angles facing the edge sum to at most pi.
+      if (!(angle_at(c, a, b) + angle_at(d, b, a) > 3.14159265358979323846 + 1e-9)) continue;
+      if (!(domain_orientation(D.row(a), D.row(d), D.row(c)) > 0) || !(domain_orientation(D.row(d), D.row(b), D.row(c)) > 0))
+        continue;
+      F.row(f1) << a, d, c;
+      F.row(f2) << d, b, c;
+      touched[f1] = touched[f2] = true;
+      --valence[a];
+      --valence[b];
+      ++valence[c];
+      ++valence[d];
+      ++flips;
+      changed = true;
+    }
+    if (!changed) break;
+  }
+  return flips;
+}
 
 int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F, int rim_min_triangles) {
   const int n = static_cast<int>(D.rows());

@@ -15,6 +15,7 @@ struct BaseMesh {
   RowMatrixX3i faces;          ///< F0, counter-clockwise in D
   RowMatrixX3d domain;         ///< n0 rows: base vertex positions in D
   std::vector<int> samples;    ///< the vertex of the parameterized surface under each base vertex
+  int surface_flips = 0;       ///< edge flips made toward the surface's Delaunay triangulation
   int valence_flips = 0;       ///< edge flips made to even out valences
   int dropped_rim_samples = 0; ///< disk rim samples dropped: fewer than rim_min_triangles triangles
 };
@@ -28,6 +29,13 @@ struct BaseMesh {
 /// \throw AlgorithmError if no valid base triangulation results.
 BaseMesh build_base_mesh(const Parameterization& param, int n0, int rim_min_triangles = 3,
                          const Eigen::VectorXd* density = nullptr);
+
+/// Flips interior edges whose two opposite angles on the surface (the base vertices' 3D
+/// positions X) sum to more than pi, while the quad is convex in D and both ends keep three
+/// edges: the Delaunay triangulation of the samples on the surface, as far as D allows. Needed
+/// where the map is not conformal: a Delaunay triangulation in D is then a poor one on the surface.
+/// \return the number of flips made.
+int flip_toward_surface_delaunay(const RowMatrixX3d& D, const RowMatrixX3d& X, RowMatrixX3i& F);
 
 /// Flips edges (never boundary edges, never making a flipped triangle in D or a duplicate
 /// edge, never leaving an interior vertex with valence < 3 or a boundary vertex with fewer

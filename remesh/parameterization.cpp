@@ -16,6 +16,7 @@
 #include "mesh/parallel.h"
 #include "mesh/topology.h"
 #include "mesh/vertex_stars.h"
+#include "remesh/stretch_map.h"
 
 namespace mrsnake {
 namespace {
@@ -490,6 +491,26 @@ Eigen::Vector3d mobius_to_center(const Eigen::Vector3d& a, const Eigen::Vector3d
   return (1.0 - a.squaredNorm()) * d / d.squaredNorm() - a;
 }
 
+namespace {
+
+// A one-chart map that flipped triangles or squeezed a protrusion past what doubles resolve is
+// replaced by the hierarchical one, which bounds the squeeze at the price of anisotropy: the
+// one-chart maps stay first, being conformal, where they work.
+void fall_back_to_hierarchical_map(const TriMesh& mesh, Parameterization& param) {
+  const int flipped = count_flipped(param.domain, mesh.F);
+  const double spread = stretch_spread_log10(mesh, param.domain);
+  if (flipped == 0 && spread <= max_stretch_spread_log10) return;
+  param.summary["sphere_map_fallback"] =
+      flipped > 0 ? "hierarchical: the one-chart map flipped " + std::to_string(flipped) + " triangles"
+                  : "hierarchical: the one-chart map's area stretch spans " + std::to_string(static_cast<int>(spread)) +
+                        " orders of magnitude";
+  param.sphere_map = SphereMap::hierarchical;
+  param.domain = hierarchical_sphere_map(mesh);
+  param.cut.clear();
+}
+
+}  // namespace
+
 Parameterization parameterize(const TriMesh& input, const ParameterizationOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   Parameterization param;
@@ -530,7 +551,10 @@ Parameterization parameterize(const TriMesh& input, const ParameterizationOption
       if (2 * negative > mesh.num_faces()) param.domain.col(0) *= -1.0;  // the disk maps' orientation is CGAL's
       balance_iterations = balance_sphere(param.domain, weights);
     };
-    if (param.sphere_map == SphereMap::punctured) {
+    if (options.sphere_map == SphereMap::hierarchical) {
+      param.sphere_map = SphereMap::hierarchical;
+      param.domain = hierarchical_sphere_map(mesh);
+    } else if (param.sphere_map == SphereMap::punctured) {
       int pole = choose_puncture_vertex(mesh);
       punctured_sphere_map(mesh, pole, param.domain);
       orient_and_balance();
@@ -559,7 +583,10 @@ Parameterization parameterize(const TriMesh& input, const ParameterizationOption
     } else {
       orient_and_balance();
     }
-    param.summary["sphere_map"] = param.sphere_map == SphereMap::two_halves ? "two_halves" : "punctured";
+    if (options.sphere_map == SphereMap::automatic) fall_back_to_hierarchical_map(mesh, param);
+    param.summary["sphere_map"] = param.sphere_map == SphereMap::two_halves   ? "two_halves"
+                                  : param.sphere_map == SphereMap::hierarchical ? "hierarchical"
+                                                                                : "punctured";
     // The sphere map's whole time: the cut search or the puncture, and the solve(s).
     param.summary["solver_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
   }
@@ -605,9 +632,12 @@ Parameterization parameterize(const TriMesh& input, const ParameterizationOption
       : param.sphere_map == SphereMap::two_halves
           ? "mean value coordinates of two halves cut across a principal axis, one per hemisphere by inverse "
             "stereographic projection, Mobius balanced"
+      : param.sphere_map == SphereMap::hierarchical
+          ? "hierarchical near-conformal map (progressive mesh from a tetrahedron, MIPS energy with an area term)"
           : "mean value coordinates of the punctured sphere, inverse stereographic, Mobius balanced";
   param.summary["domain"] = param.kind == DomainKind::sphere ? "sphere" : "disk";
   param.summary["balance_iterations"] = balance_iterations;
+  param.summary["l2_stretch"] = normalized_stretch(mesh, param.domain);
   param.summary["stretch_min"] = sorted.front() / mean_stretch;
   param.summary["stretch_max"] = sorted.back() / mean_stretch;
   param.summary["stretch_spread_log10"] = spread_log10;

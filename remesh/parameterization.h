@@ -26,7 +26,9 @@ namespace mrsnake {
 /// How a closed genus-0 surface is mapped onto the sphere.
 enum class SphereMap {
   /// two_halves for surfaces of at least ParameterizationOptions::halves_from_faces faces,
-  /// where the sparse solve dominates; punctured below.
+  /// where the sparse solve dominates; punctured below. Either falls back to hierarchical when
+  /// it flips a triangle or its area stretch spans more than 12 orders of magnitude (long
+  /// protrusions); the summary's `sphere_map_fallback` says why.
   automatic,
   /// One vertex's star removed, the rest mapped to one disk: one sparse solve.
   punctured,
@@ -34,7 +36,11 @@ enum class SphereMap {
   /// half-size solves, in parallel. Falls back to punctured when no principal plane cuts the
   /// surface into two disks, a half's solve fails, or a triangle flips or goes flat on the
   /// sphere (the summary's `sphere_map_fallback` says which).
-  two_halves
+  two_halves,
+  /// Praun and Hoppe's hierarchical stretch-minimizing map (remesh/stretch_map.h): a
+  /// tetrahedron refined by the vertex splits of a progressive mesh, each relaxed in the L2
+  /// stretch. Protrusions keep domain area in proportion to their own.
+  hierarchical
 };
 
 struct ParameterizationOptions {

@@ -1,6 +1,8 @@
 #pragma once
 // Small analytic inputs shared by the remesher's tests: a closed genus-0 surface with uneven
 // stretch, a disk, and a sheared layout of the sphere D.
+#include <cmath>
+#include <utility>
 #include <vector>
 
 #include "mesh/primitives.h"
@@ -31,6 +33,44 @@ inline TriMesh spherical_cap(int levels) {
   TriMesh cap = extract_faces(s, faces);
   cap.V.col(0) *= 2.0;
   return cap;
+}
+
+// A capsule along z: a tube of radius 1 and the given length with hemispherical caps, `around`
+// vertices per ring. From a length of about 15, a one-chart conformal map squeezes its far
+// end by more than 12 orders of magnitude in area.
+inline TriMesh capsule(double length, int around = 16) {
+  const double pi = 3.14159265358979323846;
+  std::vector<std::pair<double, double>> rings;  // (z, radius), bottom to top
+  const int cap_rings = around / 4;
+  for (int i = 1; i <= cap_rings; ++i) rings.emplace_back(-std::cos(0.5 * pi * i / cap_rings), std::sin(0.5 * pi * i / cap_rings));
+  const int tube = static_cast<int>(std::lround(length / (2 * pi / around)));
+  for (int j = 1; j <= tube; ++j) rings.emplace_back(length * j / tube, 1.0);
+  for (int i = 1; i < cap_rings; ++i)
+    rings.emplace_back(length + std::sin(0.5 * pi * i / cap_rings), std::cos(0.5 * pi * i / cap_rings));
+  const int r = static_cast<int>(rings.size());
+  TriMesh m;
+  m.V.resize(r * around + 2, 3);
+  for (int i = 0; i < r; ++i)
+    for (int k = 0; k < around; ++k) {
+      const double a = 2 * pi * k / around;
+      m.V.row(i * around + k) << rings[i].second * std::cos(a), rings[i].second * std::sin(a), rings[i].first;
+    }
+  const int south = r * around, north = south + 1;
+  m.V.row(south) << 0, 0, -1;
+  m.V.row(north) << 0, 0, length + 1;
+  std::vector<Eigen::RowVector3i> faces;
+  for (int k = 0; k < around; ++k) {
+    const int k1 = (k + 1) % around;
+    faces.emplace_back(south, k1, k);
+    for (int i = 0; i + 1 < r; ++i) {
+      faces.emplace_back(i * around + k, i * around + k1, (i + 1) * around + k1);
+      faces.emplace_back(i * around + k, (i + 1) * around + k1, (i + 1) * around + k);
+    }
+    faces.emplace_back((r - 1) * around + k, (r - 1) * around + k1, north);
+  }
+  m.F.resize(static_cast<int>(faces.size()), 3);
+  for (std::size_t f = 0; f < faces.size(); ++f) m.F.row(static_cast<int>(f)) = faces[f];
+  return m;
 }
 
 // U with 10 vertices pushed 80% of the way toward a neighbour in (U, F) (sliver triangles);

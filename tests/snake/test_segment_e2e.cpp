@@ -374,6 +374,32 @@ TEST(SegmentReal, LiverOfTheAbdomenCtReachesDice09WithoutSelfIntersections) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(SegmentReal, TheLateralVentriclesWithTheirHornsBuildAModelAndSegment) {
+  // The lateral ventricles (label 1 of the MRI crop, its larger part) have long horns: their
+  // one-chart sphere map squeezes past 12 orders of magnitude, and build-model refused them.
+  // On the hierarchical map, the model builds with every default and segments a new case.
+  MRSNAKE_REQUIRE_DATA(image, "volumes/MRIcrop-orig.gipl.gz");
+  MRSNAKE_REQUIRE_DATA(labels, "volumes/MRIcrop-seg.gipl.gz");
+  const auto dir = mrsnake::test::scratch_dir("segment-real-ventricles");
+  const std::string d = dir.string();
+  const auto b = mrsnake::test::run_mrsnake("-q build-model --labels " + labels + " --label 1 --component 1 --image " + image +
+                                            " -o " + d + "/ventricles.model");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const nlohmann::json model = nlohmann::json::parse(std::ifstream(d + "/ventricles.model/model.json"));
+  EXPECT_EQ(model["remesh_quality"]["parameterization"]["sphere_map"], "hierarchical") << model["remesh_quality"]["parameterization"];
+  const auto c = mrsnake::test::run_mrsnake("-q synth --from-image " + image + " --from-labels " + labels +
+                                            " --label 1 --pose random --deform 2 --seed 7 -o " + d + "/case");
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  const auto s = mrsnake::test::run_mrsnake("segment --image " + d + "/case/image.nii.gz --model " + d +
+                                            "/ventricles.model -o " + d + "/seg --truth " + d + "/case/truth.nii.gz --json -q");
+  ASSERT_EQ(s.exit_code, 0) << s.output;
+  const nlohmann::json rep = nlohmann::json::parse(s.output);
+  std::printf("lateral ventricles: Dice %.4f ASSD %.3f mm\n", rep["scores"]["dice"].get<double>(),
+              rep["scores"]["assd_mm"].get<double>());
+  EXPECT_GE(rep["scores"]["dice"].get<double>(), 0.85);
+  std::filesystem::remove_all(dir);
+}
+
 namespace {
 
 // A blob case of mrsnake synth at `scale` (voxel size, blur and deformation all scaled) with

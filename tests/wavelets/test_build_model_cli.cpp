@@ -271,31 +271,30 @@ std::string write_tube_labels(const std::filesystem::path& dir, int length, doub
 
 }  // namespace
 
-TEST(BuildModelCli, LongTubesArePuncturedInTheMiddleAndTheTooLongRefusedAsTooDistorted) {
+TEST(BuildModelCli, LongTubesArePuncturedInTheMiddleAndTheTooLongMappedHierarchically) {
   // A one-chart sphere map squeezes a tube's far end exponentially in its length over its
-  // radius. Punctured at one cap, a 70-voxel tube of radius 2.5 stretched past the limit
-  // (12 orders of magnitude) and a 100-voxel one lost 241 triangles to rounding, which the
-  // message blamed on degenerate triangles. Punctured near the middle, the first is modelled;
-  // the second is refused for its distortion, which is what is wrong with it.
+  // radius. Punctured near the middle, a 70-voxel tube of radius 2.5 stays within the limit
+  // (12 orders of magnitude) and keeps the conformal map. A 100-voxel one does not: its model
+  // is built on the hierarchical map, with no flipped triangle at any level.
   const auto dir = scratch_dir("build-model-cli-tube");
   const std::string model = (dir / "tube.model").string();
-  // (On the occupancy resampled to 1.2 voxels: the voxels' own surface of so thin a tube
-  // stretches past the limit from any pole.)
   const auto built = run_mrsnake("-q build-model --labels " + write_tube_labels(dir, 70, 2.5) + " --label 1 -o " + model +
                                  " --faces 2048 --mc-spacing 1.2 --json");
   ASSERT_EQ(built.exit_code, 0) << built.output;
   const auto summary = nlohmann::json::parse(built.output);
   EXPECT_EQ(summary["faces"], 2048);
   EXPECT_GT(summary["finest_level_quality"]["min_angle_deg"].get<double>(), 25.0);
+  EXPECT_EQ(load_model(model, {true}).remesh_quality["parameterization"]["sphere_map"], "punctured");
   std::filesystem::remove_all(model);
 
   const auto r = run_mrsnake("-q build-model --labels " + write_tube_labels(dir, 100, 2.5) + " --label 1 -o " + model +
                              " --faces 2048 --mc-spacing 1.2");
-  EXPECT_EQ(r.exit_code, 5) << r.output;
-  EXPECT_NE(r.output.find("the parameterization is too distorted (area stretch spans "), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("long protrusions cannot be remeshed from one chart"), std::string::npos) << r.output;
-  EXPECT_EQ(r.output.find("flipped"), std::string::npos) << r.output;
-  EXPECT_FALSE(std::filesystem::exists(model));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const ShapeModel long_tube = load_model(model, {true});
+  const nlohmann::json& param = long_tube.remesh_quality["parameterization"];
+  EXPECT_EQ(param["sphere_map"], "hierarchical");
+  EXPECT_NE(param.value("sphere_map_fallback", std::string()).find("orders of magnitude"), std::string::npos) << param;
+  for (const auto& level : long_tube.remesh_quality["per_level"]) EXPECT_EQ(level["flipped_triangles"], 0) << level;
   std::filesystem::remove_all(dir);
 }
 

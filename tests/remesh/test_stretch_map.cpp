@@ -1,0 +1,83 @@
+// The hierarchical sphere map (remesh/stretch_map.h): on a shape whose one-chart conformal map
+// squeezes past what doubles resolve, it must embed every triangle and bound the squeeze, and
+// the remesher must fall back to it and build every level without a flip in D.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "mesh/errors.h"
+#include "mesh/primitives.h"
+#include "mesh/topology.h"
+#include "remesh/parameterization.h"
+#include "remesh/remesh.h"
+#include "remesh/stretch_map.h"
+#include "tests/remesh/remesh_shapes.h"
+
+using namespace mrsnake;
+
+namespace {
+
+// log10 of the largest over the smallest area ratio A3D / A_D of the faces.
+double area_stretch_spread_log10(const TriMesh& mesh, const RowMatrixX3d& D) {
+  double lo = INFINITY, hi = 0;
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+    const Eigen::Vector3d p = D.row(mesh.F(f, 0)), q = D.row(mesh.F(f, 1)), r = D.row(mesh.F(f, 2));
+    const double ratio = (b - a).cross(c - a).norm() / (q - p).cross(r - p).norm();
+    lo = std::min(lo, ratio);
+    hi = std::max(hi, ratio);
+  }
+  return std::log10(hi / lo);
+}
+
+}  // namespace
+
+TEST(HierarchicalMap, ACapsuleTooLongForOneChartEmbedsWithItsSqueezeBounded) {
+  const TriMesh tube = test::capsule(30.0);
+  ASSERT_TRUE(topology_report(tube).is_closed_genus0());
+  ParameterizationOptions punctured;
+  punctured.sphere_map = SphereMap::punctured;
+  EXPECT_THROW(parameterize(tube, punctured), AlgorithmError);  // the one-chart map cannot
+
+  const RowMatrixX3d D = hierarchical_sphere_map(tube);
+  ASSERT_EQ(D.rows(), tube.num_vertices());
+  EXPECT_LT((D.rowwise().norm().array() - 1).abs().maxCoeff(), 1e-12);  // on the unit sphere
+  EXPECT_EQ(count_flipped(D, tube.F), 0);
+  // A conformal map's area ratio along a tube of 30 radii falls by ~e^-60 (26 orders).
+  EXPECT_LT(area_stretch_spread_log10(tube, D), 5.0);
+}
+
+TEST(HierarchicalMap, OfASphereIsNearlyASimilarity) {
+  const TriMesh sphere = icosphere(3);
+  const RowMatrixX3d D = hierarchical_sphere_map(sphere);
+  EXPECT_EQ(count_flipped(D, sphere.F), 0);
+  EXPECT_LT(normalized_stretch(sphere, D), 1.05);
+  EXPECT_LT(area_stretch_spread_log10(sphere, D), 0.5);
+}
+
+TEST(HierarchicalMap, TheAutomaticSphereMapFallsBackToItAndEveryLevelIsFlipFree) {
+  const TriMesh tube = test::capsule(30.0);
+  const Parameterization param = parameterize(tube);
+  EXPECT_EQ(param.sphere_map, SphereMap::hierarchical);
+  EXPECT_EQ(param.summary["sphere_map"], "hierarchical");
+  EXPECT_NE(param.summary.value("sphere_map_fallback", std::string()).find("hierarchical: the one-chart map"),
+            std::string::npos);
+
+  RemeshOptions options;
+  options.target_faces = 2048;
+  const RemeshResult result = remesh(tube, options);
+  ASSERT_EQ(result.parameterization["sphere_map"], "hierarchical");
+  for (int j = 0; j <= result.connectivity.levels(); ++j) {
+    EXPECT_EQ(result.levels[j].flipped_triangles, 0) << "level " << j;
+    EXPECT_EQ(count_flipped(result.levels[j].domain_positions, result.connectivity.faces[j]), 0) << "level " << j;
+  }
+  EXPECT_EQ(result.levels.back().positions.rows(), result.connectivity.vertex_count(result.connectivity.levels()));
+  // Every vertex of the finest level lies within the tube's radius of its axis segment.
+  const RowMatrixX3d& X = result.levels.back().positions;
+  for (int v = 0; v < X.rows(); ++v) {
+    const double z = std::clamp(X(v, 2), 0.0, 30.0);
+    EXPECT_LT((X.row(v) - Eigen::RowVector3d(0, 0, z)).norm(), 1.05) << v;
+  }
+}
