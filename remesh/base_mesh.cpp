@@ -68,6 +68,21 @@ void triangulate_samples(const Parameterization& param, const std::vector<bool>&
   base.valence_flips += flip_toward_regular_valence(base.domain, base.faces, rim_min_triangles);
 }
 
+// Flips the edge a-b of f1 = (a, b, c) and f2 = (b, a, d) to c-d when the quad a, d, b, c is
+// convex in D (so neither new face flips), updating the valences. \return whether it flipped.
+bool flip_if_convex_in_domain(const RowMatrixX3d& D, RowMatrixX3i& F, int f1, int f2, int a, int b, int c, int d,
+                              std::vector<int>& valence) {
+  if (!(domain_orientation(D.row(a), D.row(d), D.row(c)) > 0) || !(domain_orientation(D.row(d), D.row(b), D.row(c)) > 0))
+    return false;
+  F.row(f1) << a, d, c;
+  F.row(f2) << d, b, c;
+  --valence[a];
+  --valence[b];
+  ++valence[c];
+  ++valence[d];
+  return true;
+}
+
 }  // namespace
 
 int flip_toward_surface_delaunay(const RowMatrixX3d& D, const RowMatrixX3d& X, RowMatrixX3i& F) {
@@ -94,15 +109,8 @@ int flip_toward_surface_delaunay(const RowMatrixX3d& D, const RowMatrixX3d& X, R
       if (c == d || edge_faces.count({c, d}) || edge_faces.count({d, c}) || valence[a] <= 3 || valence[b] <= 3) continue;
       // The surface's Delaunay condition: the two angles facing the edge sum to at most pi.
       if (!(angle_at(c, a, b) + angle_at(d, b, a) > 3.14159265358979323846 + 1e-9)) continue;
-      if (!(domain_orientation(D.row(a), D.row(d), D.row(c)) > 0) || !(domain_orientation(D.row(d), D.row(b), D.row(c)) > 0))
-        continue;
-      F.row(f1) << a, d, c;
-      F.row(f2) << d, b, c;
+      if (!flip_if_convex_in_domain(D, F, f1, f2, a, b, c, d, valence)) continue;
       touched[f1] = touched[f2] = true;
-      --valence[a];
-      --valence[b];
-      ++valence[c];
-      ++valence[d];
       ++flips;
       changed = true;
     }
@@ -154,17 +162,9 @@ int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F, int rim_
       const double before = dev(a, 0) + dev(b, 0) + dev(c, 0) + dev(d, 0);
       const double after = dev(a, -1) + dev(b, -1) + dev(c, 1) + dev(d, 1);
       if (!(after < before)) continue;
-      // f1 = (a, b, c), f2 = (b, a, d): the quad is a, d, b, c counter-clockwise.
-      if (!(domain_orientation(D.row(a), D.row(d), D.row(c)) > 0) || !(domain_orientation(D.row(d), D.row(b), D.row(c)) > 0))
-        continue;
-      F.row(f1) << a, d, c;
-      F.row(f2) << d, b, c;
+      if (!flip_if_convex_in_domain(D, F, f1, f2, a, b, c, d, valence)) continue;
       touched[f1] = touched[f2] = true;
       created.insert({std::min(c, d), std::max(c, d)});
-      --valence[a];
-      --valence[b];
-      ++valence[c];
-      ++valence[d];
       ++flips;
       changed = true;
     }
