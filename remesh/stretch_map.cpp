@@ -44,16 +44,15 @@ double face_energy(const Vec3& d0, const Vec3& d1, const Vec3& d2, const Vec3& q
   return 0.5 * (q1 - q0).cross(q2 - q0).norm() * (norm2 / det + area_weight * (det + 1 / det));
 }
 
-// The surface scaled to the area of the unit sphere (or disk): the area term's minimum is then
-// an area-preserving map.
-RowMatrixX3d scaled_to_domain_area(const TriMesh& mesh, DomainKind kind) {
+// The surface scaled to the area of the unit sphere: the area term's minimum is then an
+// area-preserving map.
+RowMatrixX3d scaled_to_sphere_area(const TriMesh& mesh) {
   double area = 0;
   for (int f = 0; f < mesh.num_faces(); ++f) {
     const Vec3 a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
     area += 0.5 * (b - a).cross(c - a).norm();
   }
-  const double domain_area = kind == DomainKind::sphere ? 4 * kPi : kPi;
-  return mesh.V * std::sqrt(domain_area / area);
+  return mesh.V * std::sqrt(4 * kPi / area);
 }
 
 FaceLists faces_of_vertices(const RowMatrixX3i& F, int n) {
@@ -65,13 +64,13 @@ FaceLists faces_of_vertices(const RowMatrixX3i& F, int n) {
 
 void erase_value(std::vector<int>& list, int value) { list.erase(std::find(list.begin(), list.end(), value)); }
 
-/// Moves single vertices of D downhill in the stretch energy, never through a flip. The faces
+/// Moves single vertices on the sphere downhill in map_energy, never through a flip. The faces
 /// and their lists may change between calls (the hierarchical map's splits).
 class StarRelaxer {
  public:
-  StarRelaxer(DomainKind kind, const RowMatrixX3d& surface, const RowMatrixX3i& F, const FaceLists& faces_of,
-              RowMatrixX3d& D, std::vector<bool> on_rim, double area_weight)
-      : kind_(kind), X_(surface), F_(F), faces_of_(faces_of), D_(D), on_rim_(std::move(on_rim)), area_weight_(area_weight) {}
+  StarRelaxer(const RowMatrixX3d& surface, const RowMatrixX3i& F, const FaceLists& faces_of, RowMatrixX3d& D,
+              double area_weight)
+      : X_(surface), F_(F), faces_of_(faces_of), D_(D), area_weight_(area_weight) {}
 
   /// The energy of v's star with v at p (infinite if a face flips or goes flat).
   double star_energy(int v, const Vec3& p) const {
@@ -92,12 +91,11 @@ class StarRelaxer {
     const double e0 = star_energy(v, p);
     const auto [height, radius] = star_extent(v, p);
     if (!std::isfinite(e0) || !(height > 0)) return false;
-    const Frame frame = tangent_frame(v, p);
+    const Frame frame = tangent_frame(p);
     // Probes well inside the star: a vertex of a sliver sits very close to its opposite edge.
     const double h = 1e-3 * height;
     const auto energy_at = [&](double x, double y) { return star_energy(v, frame.at(x, y)); };
-    const Eigen::Vector2d g((energy_at(h, 0) - energy_at(-h, 0)) / (2 * h),
-                            frame.one_dimensional ? 0.0 : (energy_at(0, h) - energy_at(0, -h)) / (2 * h));
+    const Eigen::Vector2d g((energy_at(h, 0) - energy_at(-h, 0)) / (2 * h), (energy_at(0, h) - energy_at(0, -h)) / (2 * h));
     if (!std::isfinite(g.squaredNorm()) || g.squaredNorm() == 0) return false;
     const Eigen::Vector2d direction = -g.normalized();
     double step = 0.5 * radius;
@@ -115,30 +113,15 @@ class StarRelaxer {
   }
 
  private:
-  /// Where the tangent offset (x, y) of p lands on D.
+  /// Where the tangent offset (x, y) of p lands on the sphere.
   struct Frame {
-    DomainKind kind;
-    bool one_dimensional = false;  ///< a disk's rim vertex: x is an angle along the circle
     Vec3 p, t1, t2;
-    Vec3 at(double x, double y) const {
-      if (one_dimensional) {
-        const double angle = std::atan2(p.y(), p.x()) + x;
-        return {std::cos(angle), std::sin(angle), 1.0};
-      }
-      const Vec3 q = p + x * t1 + y * t2;
-      return kind == DomainKind::sphere ? Vec3(q.normalized()) : q;
-    }
+    Vec3 at(double x, double y) const { return (p + x * t1 + y * t2).normalized(); }
   };
 
-  Frame tangent_frame(int v, const Vec3& p) const {
-    Frame frame{kind_, false, p, Vec3::UnitX(), Vec3::UnitY()};
-    if (kind_ == DomainKind::disk) {
-      frame.one_dimensional = on_rim_[v];
-      return frame;
-    }
-    frame.t1 = p.unitOrthogonal();
-    frame.t2 = p.cross(frame.t1).normalized();
-    return frame;
+  static Frame tangent_frame(const Vec3& p) {
+    const Vec3 t1 = p.unitOrthogonal();
+    return {p, t1, p.cross(t1).normalized()};
   }
 
   /// The smallest height over its opposite edge, and the mean distance to its neighbours, of
@@ -157,12 +140,10 @@ class StarRelaxer {
     return {height, count > 0 ? sum / count : 0.0};
   }
 
-  DomainKind kind_;
   const RowMatrixX3d& X_;
   const RowMatrixX3i& F_;
   const FaceLists& faces_of_;
   RowMatrixX3d& D_;
-  std::vector<bool> on_rim_;
   double area_weight_;
 };
 
@@ -394,9 +375,8 @@ RowMatrixX3d hierarchical_sphere_map(const TriMesh& mesh, const HierarchicalMapO
   const std::vector<CollapsibleMesh::Collapse> history = collapse_to_tetrahedron(collapsible);
   RowMatrixX3d D = RowMatrixX3d::Zero(n, 3);
   place_tetrahedron(collapsible, D);
-  const RowMatrixX3d scaled = scaled_to_domain_area(mesh, DomainKind::sphere);
-  StarRelaxer relaxer(DomainKind::sphere, scaled, collapsible.F, collapsible.faces_of, D, std::vector<bool>(n, false),
-                      options.area_weight);
+  const RowMatrixX3d scaled = scaled_to_sphere_area(mesh);
+  StarRelaxer relaxer(scaled, collapsible.F, collapsible.faces_of, D, options.area_weight);
 
   std::vector<int> present;
   for (int v = 0; v < n; ++v)

@@ -10,8 +10,6 @@
 /// never has to undo an exponential squeeze: each leg has its domain area from the level its
 /// first vertices appear on. The price is anisotropy: a long tube cannot lie on a sphere both
 /// conformally and with its own area.
-#include <functional>
-
 #include "mesh/trimesh.h"
 #include "remesh/domain.h"
 
