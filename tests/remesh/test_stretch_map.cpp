@@ -10,6 +10,7 @@
 #include "mesh/errors.h"
 #include "mesh/primitives.h"
 #include "mesh/topology.h"
+#include "remesh/base_mesh.h"
 #include "remesh/parameterization.h"
 #include "remesh/remesh.h"
 #include "remesh/stretch_map.h"
@@ -80,4 +81,33 @@ TEST(HierarchicalMap, TheAutomaticSphereMapFallsBackToItAndEveryLevelIsFlipFree)
     const double z = std::clamp(X(v, 2), 0.0, 30.0);
     EXPECT_LT((X.row(v) - Eigen::RowVector3d(0, 0, z)).norm(), 1.05) << v;
   }
+}
+
+TEST(BaseMeshFlips, AnEdgeFacingTwoObtuseSurfaceAnglesIsFlippedWhereDAllows) {
+  // An octahedron in D with ±y tilted toward +x+z, so that the quad around the edge +z/+x is
+  // strictly convex. On the surface, ±y sit next to that edge's midpoint: the two angles facing
+  // it are about 164° each, and the surface's Delaunay triangulation has the edge +y/-y instead.
+  RowMatrixX3d octahedron(6, 3);
+  octahedron << 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1;
+  RowMatrixX3d D = octahedron;
+  D.row(2) = Eigen::RowVector3d(0.5, 1, 0.5).normalized();
+  D.row(3) = Eigen::RowVector3d(0.5, -1, 0.5).normalized();
+  RowMatrixX3i F(8, 3);
+  F << 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5;
+  ASSERT_EQ(count_flipped(D, F), 0);
+  RowMatrixX3d X = D;
+  X.row(2) << 0.5, 0.1, 0.5;
+  X.row(3) << 0.5, -0.1, 0.5;
+  EXPECT_GE(flip_toward_surface_delaunay(D, X, F), 1);
+  EXPECT_EQ(count_flipped(D, F), 0);
+  bool joined = false;
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) joined = joined || (F(f, k) == 2 && F(f, (k + 1) % 3) == 3);
+  EXPECT_TRUE(joined);
+  // On the octahedron itself every angle is 60°: nothing to flip.
+  RowMatrixX3i G(8, 3);
+  G << 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5;
+  EXPECT_EQ(flip_toward_surface_delaunay(octahedron, octahedron, G), 0);
+  // With ±y antipodal in D, the new faces would lie on a great circle: D forbids the flip.
+  EXPECT_EQ(flip_toward_surface_delaunay(octahedron, X, G), 0);
 }
