@@ -166,6 +166,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   result.connectivity = subdivide_connectivity(base.faces, n0, levels);
   result.parameterization["base_vertices"] = n0;
   result.parameterization["base_faces"] = base.faces.rows();
+  result.parameterization["base_surface_flips"] = base.surface_flips;
   result.parameterization["base_valence_flips"] = base.valence_flips;
   result.parameterization["base_dropped_rim_samples"] = base.dropped_rim_samples;
 
