@@ -102,11 +102,11 @@ void add_build_model_command(CLI::App& app) {
     SphereMap sphere_map = SphereMap::automatic;
     // Off by default, unlike remesh: a model's vertices stay on the reference surface. With the
     // fit, the segmentation bench's 128³ Dice fell by 0.0002-0.0004 on 9 of 10 cases
-    // (docs/bench-segment.md, session 6).
+    // (bench/segment).
     int fit_rounds = 0;
     // 1, unlike remesh's 0.5: more vertices where the organ bends. With 0.5 the real-data Dice
     // fell on 3 of 4 structures (left hippocampus 0.9499 -> 0.9446) and the synthetic ones moved
-    // by -0.0022..+0.0007 (docs/bench-segment.md, session 8). 0.5 buys triangle quality, and
+    // by -0.0022..+0.0007 (bench/segment, bench/real_data.sh). 0.5 buys triangle quality, and
     // the snake measured better with the denser sampling of the bends.
     double curvature_weight = 1.0;
     std::string profile_alignment = "auto";

@@ -49,7 +49,7 @@ struct ParameterizationOptions {
   /// liver its solve takes 0.55 s instead of 0.87 s; on the small benchmark meshes (4k-28k
   /// faces) the whole remeshing takes about as long either way, and the punctured map's worst
   /// triangles come out better on bear, blobby and retinal, worse on heart
-  /// (docs/bench-build-model.md, session 5).
+  /// (bench/bench_build_model.sh, bench/remesh).
   int halves_from_faces = 100000;
 };
 

@@ -116,7 +116,7 @@ struct RemeshOptions {
   /// surface. Only the finest level, which is what is measured against the input (a model's
   /// coarse levels are recomputed from it by the wavelet analysis). With all_vertices only, like
   /// the snap and the repair. 0 = off: every vertex stays exactly on the input, as in the paper.
-  /// 1: RMS -9 to -51 % on the bench meshes (docs/bench-remesh.md, session 6).
+  /// 1: RMS -9 to -51 % on the bench meshes (bench/remesh).
   int fit_rounds = 1;
   /// Build RemeshResult::input_locator even if nothing here needs it (a caller that measures
   /// against the input then gets the tree built on the other core while the map is solved).
