@@ -1,5 +1,6 @@
 #include "remesh/sizing.h"
 
+#include <cmath>
 #include <vector>
 
 namespace mrsnake {
@@ -44,6 +45,45 @@ Eigen::VectorXd smooth_vertex_field(const TriMesh& mesh, Eigen::VectorXd field, 
     field = next.cwiseQuotient(weight);
   }
   return field;
+}
+
+Eigen::VectorXd vertex_areas(const TriMesh& mesh) {
+  Eigen::VectorXd area = Eigen::VectorXd::Zero(mesh.num_vertices());
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    const Eigen::RowVector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+    const double third = (b - a).cross(c - a).norm() / 6.0;
+    for (int k = 0; k < 3; ++k) area[mesh.F(f, k)] += third;
+  }
+  return area;
+}
+
+namespace {
+
+// Points per unit area of an equilateral grid of spacing h = max_bend / κ: 2 / (sqrt(3) h²).
+Eigen::VectorXd bend_bound(const Eigen::VectorXd& curvature, double max_bend) {
+  return (2.0 / std::sqrt(3.0)) * (curvature / max_bend).array().square().matrix();
+}
+
+}  // namespace
+
+double bend_bound_points(const TriMesh& mesh, const Eigen::VectorXd& curvature, double max_bend) {
+  return vertex_areas(mesh).dot(bend_bound(curvature, max_bend));
+}
+
+Eigen::VectorXd bend_bounded_density(const TriMesh& mesh, const Eigen::VectorXd& density,
+                                     const Eigen::VectorXd& curvature, double points, double max_bend) {
+  const Eigen::VectorXd area = vertex_areas(mesh);
+  const Eigen::VectorXd floor = bend_bound(curvature, max_bend);
+  // Scale t of the density (points per area = t·density where the bound is slack) such that
+  // Σ area·max(t·density, floor) = points; the count grows with t, so bisect.
+  const auto count = [&](double t) { return area.dot((t * density).cwiseMax(floor)); };
+  double lo = 0, hi = points / area.dot(density);
+  for (int it = 0; it < 60; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (count(mid) < points ? lo : hi) = mid;
+  }
+  const double t = std::max(hi, 1e-12 * points / area.dot(density));
+  return density.cwiseMax(floor / t);
 }
 
 }  // namespace mrsnake

@@ -19,4 +19,22 @@ Eigen::VectorXd vertex_curvature(const TriMesh& mesh, int smoothing = 3);
 /// \throw nothing beyond std::bad_alloc (passes <= 0 returns field unchanged).
 Eigen::VectorXd smooth_vertex_field(const TriMesh& mesh, Eigen::VectorXd field, int passes);
 
+/// The area of each vertex's share of the surface: a third of each incident triangle's.
+/// \pre mesh has no unreferenced vertices.
+Eigen::VectorXd vertex_areas(const TriMesh& mesh);
+
+/// A relative point density (one entry > 0 per vertex) raised where `points` points spread by it
+/// would be spaced wider than max_bend / curvature, so that no edge between them turns the
+/// surface's normal by more than about max_bend radians: a tube of radius r then gets at least
+/// about 2π·0.64 / max_bend points around (curvature() of a tube is ~0.64 / r). The result is
+/// the density where the bound is slack and the bound where it is not, in the same units.
+/// \pre density, curvature have one entry per vertex; points > 0; max_bend > 0.
+Eigen::VectorXd bend_bounded_density(const TriMesh& mesh, const Eigen::VectorXd& density,
+                                     const Eigen::VectorXd& curvature, double points, double max_bend);
+
+/// The points that bend_bounded_density()'s bound alone asks for, Σ area·2κ²/(√3·max_bend²):
+/// where that nears the points available, the density can no longer follow its own sizing.
+/// \pre curvature has one entry per vertex; max_bend > 0.
+double bend_bound_points(const TriMesh& mesh, const Eigen::VectorXd& curvature, double max_bend);
+
 }  // namespace mrsnake

@@ -50,6 +50,39 @@ TEST(BaseMeshDensity, PutsMoreBaseVerticesWhereTheDensityIsHigher) {
   EXPECT_GT(dense, 2.5);
 }
 
+// On a sphere of radius r (κ = 1/r), spacing at most b·r asks for its area over an
+// equilateral vertex's share, 4πr² / (√3/2 (b r)²) = 8π / (√3 b²) points, at any r.
+TEST(Sizing, TheBendBoundOnASphereAsksForItsAreaOverTheSpacingSquared) {
+  for (const double r : {0.01, 1.0, 300.0}) {
+    TriMesh sphere = icosphere(4);
+    sphere.V *= r;
+    const Eigen::VectorXd kappa = Eigen::VectorXd::Constant(sphere.num_vertices(), 1.0 / r);
+    EXPECT_NEAR(vertex_areas(sphere).sum(), 4 * 3.14159265358979 * r * r, 0.01 * 4 * 3.14159265358979 * r * r);
+    EXPECT_NEAR(bend_bound_points(sphere, kappa, 2.0), 8 * 3.14159265358979 / (std::sqrt(3.0) * 4), 0.05) << r;
+  }
+}
+
+// Curvature φ on the x > 0 half only, density 1 everywhere. Where the bound is slack the
+// density comes back unchanged. Where it is not, the bent half gets the bound's own density,
+// with the scale t of the rest set so that Σ area·max(t·1, floor) is the points asked for.
+TEST(Sizing, TheBendBoundRaisesTheDensityOnlyWhereItIsTight) {
+  const TriMesh sphere = icosphere(3);
+  const int n = sphere.num_vertices();
+  const Eigen::VectorXd area = vertex_areas(sphere);
+  Eigen::VectorXd kappa = Eigen::VectorXd::Zero(n);
+  for (int v = 0; v < n; ++v)
+    if (sphere.V(v, 0) > 0) kappa[v] = 3.0;
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(n);
+  const double bound = bend_bound_points(sphere, kappa, 1.0);
+  EXPECT_TRUE(bend_bounded_density(sphere, ones, kappa, 100 * bound, 1.0) == ones);
+
+  const double points = 1.5 * bound;
+  const Eigen::VectorXd raised = bend_bounded_density(sphere, ones, kappa, points, 1.0);
+  const double floor = 2.0 / std::sqrt(3.0) * 9.0, bent_area = area.dot((kappa.array() > 0).cast<double>().matrix());
+  const double t = (points - bent_area * floor) / (area.sum() - bent_area);
+  for (int v = 0; v < n; ++v) EXPECT_NEAR(raised[v], kappa[v] > 0 ? floor / t : 1.0, 1e-6 * floor / t) << v;
+}
+
 // Averaging keeps a constant field, spreads a spike to its neighbours and never leaves the
 // range of the values.
 TEST(Sizing, SmoothingAVertexFieldSpreadsASpikeAndKeepsConstants) {

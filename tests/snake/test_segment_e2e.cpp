@@ -361,10 +361,11 @@ TEST(SegmentReal, LiverOfTheAbdomenCtReachesDice09WithoutSelfIntersections) {
     const nlohmann::json rep = nlohmann::json::parse(s.output);
     EXPECT_EQ(rep["self_intersections"], 0);
     // The finest level's edges (~2.3 mm) are below the 3 mm voxels: synthesized, not deformed.
-    ASSERT_EQ(rep["levels"].size(), 5u);
-    EXPECT_FALSE(rep["levels"][4]["deformed"].get<bool>());
-    EXPECT_EQ(rep["levels"][4]["iterations"], 0);
-    EXPECT_TRUE(rep["levels"][3]["deformed"].get<bool>());
+    const std::size_t finest = rep["levels"].size() - 1;
+    ASSERT_GE(finest, 3u);
+    EXPECT_FALSE(rep["levels"][finest]["deformed"].get<bool>());
+    EXPECT_EQ(rep["levels"][finest]["iterations"], 0);
+    EXPECT_TRUE(rep["levels"][finest - 1]["deformed"].get<bool>());
     dice[iterations == 0 ? 0 : 1] = rep["scores"]["dice"].get<double>();
     std::printf("real liver%s: Dice %.4f ASSD %.3f mm, self-intersections %d\n", cap.c_str(), dice[iterations == 0 ? 0 : 1],
                 rep["scores"]["assd_mm"].get<double>(), rep["self_intersections"].get<int>());
