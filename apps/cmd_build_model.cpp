@@ -123,9 +123,6 @@ void add_build_model_command(CLI::App& app) {
   levels->excludes(faces);
   add_sphere_map_option(*cmd, a->sphere_map);
   add_fit_rounds_option(*cmd, a->fit_rounds);
-  cmd->add_option("--curvature-weight", a->curvature_weight,
-                  "Denser where the surface bends: 3D density 1 + w·κ/mean κ (default 1, remesh's is 0.5; 0 = even spacing)")
-      ->check(CLI::Range(0.0, 100.0));
   cmd->add_option("--predict", a->predict, "Wavelet predict step: butterfly (default) or linear")
       ->check(CLI::IsMember({"butterfly", "linear"}));
   auto* smooth = cmd->add_option("--smooth", a->smooth,

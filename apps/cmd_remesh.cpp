@@ -20,9 +20,10 @@ void add_remesh_command(CLI::App& app) {
                                  "(level_0.vtp ... level_L.vtp, report.json and report.html)");
   struct Args {
     std::string mesh, out;
-    RemeshOptions options;  // the options bound directly, so their defaults live in one place
+    // Bound directly, so that the defaults live in one place. The method's other settings are
+    // one set of defaults for every shape (remesh/remesh.h), not options of the command.
+    RemeshOptions options;
     bool no_relax = false, strict = false, json = false, compare_unrelaxed = false;
-    bool repair_finest_only = false, repair_no_guard = false;
   };
   auto args = std::make_shared<Args>();
   cmd->add_option("MESH", args->mesh, "Input surface (.vtp .vtk .stl .ply .obj .off): a disk or a closed genus-0 surface")
@@ -40,58 +41,8 @@ void add_remesh_command(CLI::App& app) {
   auto* strict = cmd->add_flag("--strict", args->strict,
                                "Relax only the new vertices of each level (the paper's exact method)");
   no_relax->excludes(strict);
-  cmd->add_option("--density-exponent", args->options.density_exponent, "Lloyd density = stretch^e (default 2: even 3D spacing)")
-      ->check(CLI::Range(0.0, 8.0));
-  cmd->add_option("--curvature-weight", args->options.curvature_weight, "Denser where the surface bends: 3D density 1 + w·κ/mean κ (default 0.5; 0 = even spacing)")
-      ->check(CLI::Range(0.0, 100.0));
-  cmd->add_option("--curvature-exponent", args->options.curvature_exponent,
-                  "Curvature sizing exponent p: 3D density 1 + w·min((κ/mean κ)^p, 3) (default " +
-                      std::to_string(RemeshOptions{}.curvature_exponent).substr(0, 4) + ")")
-      ->check(CLI::Range(0.01, 4.0));
-  cmd->add_option("--surface-relax-iterations", args->options.surface_relax_iterations,
-                  "Iterations per level of tangential relaxation on the surface after the shape smoothing (default " +
-                      std::to_string(RemeshOptions{}.surface_relax_iterations) + "; 0 = off; not with --strict or --no-relax)")
-      ->check(CLI::Range(0, 1000));
-  cmd->add_option("--surface-relax-floor", args->options.surface_relax_quality_floor,
-                  "Surface relaxation moves may not lower a vertex's worst triangle quality below min(before, this) (default " +
-                      std::to_string(RemeshOptions{}.surface_relax_quality_floor).substr(0, 4) + "; 0 = no check; not with --strict or --no-relax)")
-      ->check(CLI::Range(0.0, 1.0));
-  cmd->add_flag("--smooth-rim,!--no-smooth-rim", args->options.smooth_rim,
-                std::string("Disk inputs: rim vertices slide along the rim during smoothing (default ") +
-                    (RemeshOptions{}.smooth_rim ? "on" : "off") + "; not with --strict or --no-relax)");
-  cmd->add_option("--base-density-exponent", args->options.base_density_exponent,
-                  "Base vertices closer where the surface bends: farthest-point distances scaled by the curvature sizing^e "
-                  "(default " + std::to_string(RemeshOptions{}.base_density_exponent).substr(0, 4) + "; 0 = even)")
-      ->check(CLI::Range(0.0, 4.0));
-  cmd->add_option("--base-density-smoothing", args->options.base_density_smoothing,
-                  "Passes of 1-ring averaging of that density first (default " +
-                      std::to_string(RemeshOptions{}.base_density_smoothing) + "; -1 = about one base spacing)")
-      ->check(CLI::Range(-1, 1000));
-  cmd->add_option("--snap-tips", args->options.snap_tips,
-                  "Finest level: up to this many vertices snap onto the input's vertices farthest from it (default " +
-                      std::to_string(RemeshOptions{}.snap_tips) + "; 0 = off; not with --strict or --no-relax)")
-      ->check(CLI::Range(0, 100000));
   add_fit_rounds_option(*cmd, args->options.fit_rounds);
   add_sphere_map_option(*cmd, args->options.sphere_map);
-  cmd->add_option("--iterations", args->options.lloyd_iterations, "Lloyd iterations per level (default 8)")->check(CLI::Range(0, 1000));
-  cmd->add_option("--shape-iterations", args->options.shape_iterations,
-                  "Iterations per level of 3D shape smoothing after Lloyd (default " + std::to_string(RemeshOptions{}.shape_iterations) + "; not with --strict or --no-relax)")
-      ->check(CLI::Range(0, 1000));
-  cmd->add_option("--repair-sweeps", args->options.repair_sweeps,
-                  "Sweeps per level of the final repair of the worst triangles (default 6; 0 = off; not with --strict or --no-relax)")
-      ->check(CLI::Range(0, 1000));
-  cmd->add_option("--repair-threshold", args->options.repair_threshold,
-                  "Triangles with quality Q below this are repaired (default " + std::to_string(RemeshOptions{}.repair_threshold).substr(0, 4) + ")")
-      ->check(CLI::Range(0.01, 1.0));
-  cmd->add_flag("--repair-finest-only", args->repair_finest_only, "Repair only the finest level (default: every level)");
-  cmd->add_flag("--repair-no-guard", args->repair_no_guard,
-                "On the finest level, also take repair moves that take triangles further from the input");
-  cmd->add_option("--repair-tolerance", args->options.repair_error_tolerance,
-                  "The guard lets triangles move away from the input by up to this x the mean edge length (default 0.03)")
-      ->check(CLI::Range(0.0, 10.0));
-  cmd->add_option("--rim-min-triangles", args->options.rim_min_triangles,
-                  "Disk inputs: base rim vertices with fewer triangles are dropped (default 3; 1 = keep all)")
-      ->check(CLI::Range(1, 3));
   cmd->add_flag("--compare-unrelaxed", args->compare_unrelaxed,
                 "Also remesh without relaxation (a second run) and compare both in report.html and report.json")
       ->excludes(no_relax);
@@ -108,8 +59,6 @@ void add_remesh_command(CLI::App& app) {
     require_replaceable(args->out, earlier);
     const TriMesh input = read_mesh(args->mesh);
     RemeshOptions options = args->options;
-    options.repair_coarse_levels = !args->repair_finest_only;
-    options.repair_guard_finest = !args->repair_no_guard;
     options.relax = args->no_relax ? RelaxMode::none : args->strict ? RelaxMode::new_vertices_only : RelaxMode::all_vertices;
     if (!global_options().quiet) options.progress = terminal_progress();
     const RemeshResult result = remesh(input, options);

