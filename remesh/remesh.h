@@ -61,11 +61,10 @@ struct RemeshOptions {
   /// Where a base spread by the curvature sizing alone would cut off tips, bends and thin
   /// tubes, the base grows until no base edge need turn the surface's normal by much more than
   /// this (radians; remesh/sizing.h): when that bound asks for more than half of the base, the
-  /// base grows 4x (the hierarchy has one level less) and is spread by the bound.
+  /// base grows 4x, once (the hierarchy has one level less), and is spread by the bound.
   /// 2: on horse, armadillo, human and the lateral ventricles at 16k faces, Hausdorff 2.5, 5.8,
   /// 1.6 and 1.2 % fell to 0.46, 1.0, 0.73 and 0.56 %, and Q mean rose by 0.03 to 0.12; the
-  /// price is interior valence 6 at ~98 % instead of 99 % where the base grows. 1.5 grew
-  /// those bases to 2k vertices (92 % valence 6, one level above the base). 0 = off.
+  /// price is interior valence 6 at ~98 % instead of 99 % where the base grows. 0 = off.
   double max_base_bend = 2.0;
   /// Passes of 1-ring averaging of that density first; -1 = about one base spacing,
   /// round(sqrt(input vertices / n0)). 3: without it the liver's base followed voxel steps
