@@ -14,7 +14,7 @@
 #include "snake/model_bridge.h"
 #include "snake/rasterize.h"
 #include "snake/segment.h"
-#include "snake/shrink_wrap.h"
+#include "tests/support/shrink_wrap.h"
 #include "snake/synth.h"
 #include "wavelets/model.h"
 

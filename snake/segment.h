@@ -37,14 +37,6 @@ struct SnakeModel {
   const RowMatrixX3i& faces(int j) const { return connectivity.faces[j]; }
 };
 
-/// A stand-in model without lifting: S_j is the prefix of the finest level, the details are
-/// the offsets of each new vertex from its parent edge's midpoint in the edge's local frame
-/// (edge direction, mean normal of its endpoints, their cross product; scaled by the edge
-/// length), so that synthesis follows a similarity of S_j. Used for tests and when no
-/// wavelet model is at hand.
-/// \pre finest has conn.vertex_counts.back() rows.
-SnakeModel midpoint_frame_model(const SubdivisionConnectivity& conn, const RowMatrixX3d& finest);
-
 enum class InitMode {
   automatic,             ///< register+fit when the model has a reference image, else moments+fit (default)
   pose,                  ///< the model's physical pose as is

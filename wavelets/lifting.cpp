@@ -136,12 +136,6 @@ PredictScheme parse_predict_scheme(const std::string& name) {
   throw InputError("unknown wavelet predict scheme '" + name + "'; use 'linear' or 'butterfly'");
 }
 
-DetailFrame parse_detail_frame(const std::string& name) {
-  if (name == "global") return DetailFrame::global;
-  if (name == "local") return DetailFrame::local;
-  throw InputError("unknown detail frame '" + name + "'; use 'global' or 'local'");
-}
-
 WaveletTransform::WaveletTransform(SubdivisionConnectivity conn, WaveletOptions options)
     : conn_(std::move(conn)), options_(options) {
   if (conn_.faces.empty() || conn_.vertex_counts.size() != conn_.faces.size())

@@ -55,8 +55,6 @@ std::string to_string(PredictScheme scheme);
 std::string to_string(DetailFrame frame);
 /// \throw InputError for a name other than "linear" or "butterfly".
 PredictScheme parse_predict_scheme(const std::string& name);
-/// \throw InputError for a name other than "global" or "local".
-DetailFrame parse_detail_frame(const std::string& name);
 
 /// The size of the details of one level, measured on the global (mm) detail vectors.
 struct DetailStats {

@@ -7,10 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 
-#include "mesh/atomic_file.h"
-#include "mesh/errors.h"
 
 namespace mrsnake::reports {
 
@@ -50,17 +47,6 @@ std::vector<std::uint8_t> Canvas::png() const {
   writer->Write();
   vtkUnsignedCharArray* result = writer->GetResult();
   return {result->GetPointer(0), result->GetPointer(0) + result->GetNumberOfValues()};
-}
-
-void Canvas::save_png(const std::string& path) const {
-  const auto bytes = png();
-  AtomicOutput out(path);
-  {
-    std::ofstream f(out.temp_path(), std::ios::binary);
-    f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    if (!f) throw OutputError("cannot write '" + path + "'");
-  }
-  out.commit();
 }
 
 std::string base64(const std::vector<std::uint8_t>& bytes) {

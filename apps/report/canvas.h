@@ -25,9 +25,6 @@ class Canvas {
   void line(double x0, double y0, double x1, double y1, Rgb c, int thickness = 1);
   /// PNG bytes of the picture (VTK's PNG writer, in memory).
   std::vector<std::uint8_t> png() const;
-  /// Writes the PNG atomically.
-  /// \throw OutputError if it cannot be written.
-  void save_png(const std::string& path) const;
 
  private:
   int width_, height_;

@@ -22,6 +22,7 @@
 #include "snake/reference_image.h"
 #include "snake/registration_itk.h"
 #include "snake/segment.h"
+#include "tests/support/midpoint_frame_model.h"
 #include "snake/synth.h"
 #include "tests/test_support.h"
 #include "tests/wavelets/hierarchies.h"

@@ -27,7 +27,7 @@
 #include "snake/image_pyramid.h"
 #include "snake/rasterize.h"
 #include "snake/segment.h"
-#include "snake/shrink_wrap.h"
+#include "tests/support/shrink_wrap.h"
 #include "snake/synth.h"
 
 using namespace mrsnake;

@@ -23,6 +23,7 @@
 #include "snake/rasterize.h"
 #include "snake/sampler.h"
 #include "snake/segment.h"
+#include "tests/support/midpoint_frame_model.h"
 #include "snake/surface_geometry.h"
 #include "tests/test_support.h"
 
