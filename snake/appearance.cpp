@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mesh/byte_codec.h"
 #include "mesh/errors.h"
 #include "snake/sampler.h"
 #include "snake/surface_geometry.h"
@@ -208,52 +209,34 @@ constexpr char kMagic[8] = {'M', 'R', 'S', 'A', 'P', 'P', '0', '2'};
 // Version 01 differs only in having no centre byte per level.
 constexpr char kMagicVersion01[8] = {'M', 'R', 'S', 'A', 'P', 'P', '0', '1'};
 
-template <class T>
-void put(std::vector<std::uint8_t>& b, const T& x) {
-  const auto* p = reinterpret_cast<const std::uint8_t*>(&x);
-  b.insert(b.end(), p, p + sizeof(T));
-}
-
-struct Reader {
-  const std::vector<std::uint8_t>& b;
-  std::size_t pos = 0;
-  template <class T>
-  T get() {
-    if (pos + sizeof(T) > b.size())
-      throw InputError("the model's appearance section is truncated; rebuild the model with build-model --image");
-    T x;
-    std::memcpy(&x, b.data() + pos, sizeof(T));
-    pos += sizeof(T);
-    return x;
-  }
-};
+constexpr const char* kTruncated = "the model's appearance section is truncated; rebuild the model with build-model --image";
 }  // namespace
 
 std::vector<std::uint8_t> serialize_appearance(const Appearance& a) {
-  std::vector<std::uint8_t> b(kMagic, kMagic + 8);
-  put<std::int32_t>(b, a.half_length);
-  put<std::int32_t>(b, static_cast<std::int32_t>(a.levels.size()));
-  put<double>(b, a.region.inside);
-  put<double>(b, a.region.outside);
-  put<double>(b, a.inside_spread);
-  put<double>(b, a.outside_spread);
-  put<double>(b, a.shell_mm);
+  ByteWriter b(std::vector<std::uint8_t>(kMagic, kMagic + 8));
+  b.put<std::int32_t>(a.half_length);
+  b.put<std::int32_t>(static_cast<std::int32_t>(a.levels.size()));
+  b.put<double>(a.region.inside);
+  b.put<double>(a.region.outside);
+  b.put<double>(a.inside_spread);
+  b.put<double>(a.outside_spread);
+  b.put<double>(a.shell_mm);
   for (const LevelAppearance& l : a.levels) {
-    put<double>(b, l.spacing_mm);
-    put<std::uint8_t>(b, l.centre == ProfileCentre::edges ? 1 : 0);
-    put<std::int32_t>(b, static_cast<std::int32_t>(l.profiles.rows()));
-    put<std::int32_t>(b, static_cast<std::int32_t>(l.profiles.cols()));
+    b.put<double>(l.spacing_mm);
+    b.put<std::uint8_t>(l.centre == ProfileCentre::edges ? 1 : 0);
+    b.put<std::int32_t>(static_cast<std::int32_t>(l.profiles.rows()));
+    b.put<std::int32_t>(static_cast<std::int32_t>(l.profiles.cols()));
     for (int r = 0; r < l.profiles.rows(); ++r)
-      for (int c = 0; c < l.profiles.cols(); ++c) put<float>(b, l.profiles(r, c));
+      for (int c = 0; c < l.profiles.cols(); ++c) b.put<float>(l.profiles(r, c));
   }
-  return b;
+  return b.take();
 }
 
 Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes) {
   const bool version01 = bytes.size() >= 8 && std::memcmp(bytes.data(), kMagicVersion01, 8) == 0;
   if (bytes.size() < 8 || (!version01 && std::memcmp(bytes.data(), kMagic, 8) != 0))
     throw InputError("the model's appearance section is not in a format this build reads; rebuild the model");
-  Reader r{bytes, 8};
+  ByteReader r(bytes, 8, kTruncated);
   Appearance a;
   a.half_length = r.get<std::int32_t>();
   const int levels = r.get<std::int32_t>();
@@ -280,7 +263,7 @@ Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes) {
     }
     const int rows = r.get<std::int32_t>(), cols = r.get<std::int32_t>();
     if (rows < 0 || cols != 2 * a.half_length + 1 || !(l.spacing_mm > 0) ||
-        static_cast<std::size_t>(rows) * cols * sizeof(float) > bytes.size() - r.pos)
+        static_cast<std::size_t>(rows) * cols * sizeof(float) > bytes.size() - r.position())
       throw InputError("the model's appearance section is inconsistent; rebuild the model");
     l.profiles.resize(rows, cols);
     for (int i = 0; i < rows; ++i)
@@ -289,7 +272,7 @@ Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes) {
       throw InputError("the model's appearance section holds non-finite profiles; rebuild the model");
     a.levels.push_back(std::move(l));
   }
-  if (r.pos != bytes.size()) throw InputError("the model's appearance section has trailing bytes; rebuild the model");
+  if (r.position() != bytes.size()) throw InputError("the model's appearance section has trailing bytes; rebuild the model");
   return a;
 }
 

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mesh/byte_codec.h"
 #include "mesh/errors.h"
 #include "wavelets/model_io.h"
 
@@ -19,28 +20,10 @@ constexpr std::uint32_t kVersion = 1;
 constexpr std::size_t kHeaderBytes = 8 + 4 + 3 * 4 + 15 * 8;  // magic, version, size, spacing, origin, direction
 constexpr std::uint32_t kMaxAxis = 1024;
 
-template <class T>
-void put(std::vector<std::uint8_t>& b, T x) {
-  const auto* p = reinterpret_cast<const std::uint8_t*>(&x);
-  b.insert(b.end(), p, p + sizeof(T));
-}
-
 InputError defect(const std::string& what) {
   return InputError("the model's reference image section " + what + "; rebuild the model with build-model --image");
 }
 
-struct Reader {
-  const std::vector<std::uint8_t>& b;
-  std::size_t pos = 0;
-  template <class T>
-  T get() {
-    if (pos + sizeof(T) > b.size()) throw defect("is truncated");
-    T x;
-    std::memcpy(&x, b.data() + pos, sizeof(T));
-    pos += sizeof(T);
-    return x;
-  }
-};
 }  // namespace
 
 Volume make_reference_crop(const Volume& image, const RowMatrixX3d& V, const ReferenceImageOptions& options) {
@@ -96,21 +79,20 @@ Volume make_reference_crop(const Volume& image, const RowMatrixX3d& V, const Ref
 }
 
 std::vector<std::uint8_t> serialize_reference_image(const Volume& r) {
-  std::vector<std::uint8_t> b(kMagic, kMagic + 8);
-  b.reserve(kHeaderBytes + 4 * r.data.size() + 8);
-  put<std::uint32_t>(b, kVersion);
-  for (int a = 0; a < 3; ++a) put<std::uint32_t>(b, static_cast<std::uint32_t>(r.size[a]));
-  for (double s : r.spacing) put<double>(b, s);
-  for (double o : r.origin) put<double>(b, o);
-  for (double d : r.direction) put<double>(b, d);
-  for (float v : r.data) put<float>(b, v);
-  put<std::uint64_t>(b, fnv1a64(b.data(), b.size()));
-  return b;
+  ByteWriter b(std::vector<std::uint8_t>(kMagic, kMagic + 8));
+  b.put<std::uint32_t>(kVersion);
+  for (int a = 0; a < 3; ++a) b.put<std::uint32_t>(static_cast<std::uint32_t>(r.size[a]));
+  for (double s : r.spacing) b.put<double>(s);
+  for (double o : r.origin) b.put<double>(o);
+  for (double d : r.direction) b.put<double>(d);
+  for (float v : r.data) b.put<float>(v);
+  b.put<std::uint64_t>(fnv1a64(b.bytes().data(), b.bytes().size()));
+  return b.take();
 }
 
 Volume deserialize_reference_image(const std::vector<std::uint8_t>& bytes) {
   if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) throw defect("is not in a format this build reads");
-  Reader r{bytes, 8};
+  ByteReader r(bytes, 8, defect("is truncated").what());
   if (r.get<std::uint32_t>() != kVersion) throw defect("has a version this build does not read");
   Volume v;
   for (int a = 0; a < 3; ++a) {
@@ -125,7 +107,7 @@ Volume deserialize_reference_image(const std::vector<std::uint8_t>& bytes) {
   if (bytes.size() < expected) throw defect("is truncated");
   if (bytes.size() > expected) throw defect("has trailing bytes");
   std::uint64_t stored;
-  std::memcpy(&stored, bytes.data() + expected - 8, 8);
+  stored = ByteReader(bytes, expected - 8, "").get<std::uint64_t>();
   if (stored != fnv1a64(bytes.data(), expected - 8)) throw defect("was altered or corrupted (its checksum does not match)");
   for (int a = 0; a < 3; ++a)
     // Bounds far beyond any scanner's (µm to m voxels, km away) keep index arithmetic finite.
@@ -139,7 +121,8 @@ Volume deserialize_reference_image(const std::vector<std::uint8_t>& bytes) {
       if (!(std::abs(dot - (a == b ? 1.0 : 0.0)) < 1e-6)) throw defect("has a direction matrix that is not orthonormal");
     }
   v.data.resize(v.num_voxels());
-  std::memcpy(v.data.data(), bytes.data() + kHeaderBytes, 4 * v.num_voxels());
+  ByteReader voxels(bytes, kHeaderBytes, defect("is truncated").what());
+  for (float& x : v.data) x = voxels.get<float>();
   for (float x : v.data)
     if (!std::isfinite(x)) throw defect("holds non-finite values");
   return v;

@@ -10,6 +10,7 @@
 #include <iterator>
 
 #include "mesh/atomic_file.h"
+#include "mesh/byte_codec.h"
 #include "mesh/errors.h"
 #include "mesh/json_text.h"
 #include "mesh/mesh_io.h"
@@ -26,54 +27,6 @@ constexpr int kMaxLevels = 12;
 constexpr const char* kManifest = "model.json";
 constexpr const char* kDetails = "details.bin";
 constexpr const char* kFormatName = "mrsnake-model";
-
-// Little-endian encoding, independent of the host's byte order.
-class ByteWriter {
- public:
-  void u32(std::uint32_t v) {
-    for (int i = 0; i < 4; ++i) bytes.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
-  }
-  void u64(std::uint64_t v) {
-    for (int i = 0; i < 8; ++i) bytes.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
-  }
-  void i32(std::int32_t v) { u32(static_cast<std::uint32_t>(v)); }
-  void f64(double d) {
-    std::uint64_t b;
-    std::memcpy(&b, &d, 8);
-    u64(b);
-  }
-  std::vector<std::uint8_t> bytes;
-};
-
-class ByteReader {
- public:
-  ByteReader(const std::vector<std::uint8_t>& b, std::size_t end) : bytes_(b), end_(end) {}
-  std::uint32_t u32() {
-    std::uint32_t v = 0;
-    for (int i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(bytes_[pos_ + i]) << (8 * i);
-    pos_ += 4;
-    return v;
-  }
-  std::uint64_t u64() {
-    std::uint64_t v = 0;
-    for (int i = 0; i < 8; ++i) v |= static_cast<std::uint64_t>(bytes_[pos_ + i]) << (8 * i);
-    pos_ += 8;
-    return v;
-  }
-  std::int32_t i32() { return static_cast<std::int32_t>(u32()); }
-  double f64() {
-    const std::uint64_t b = u64();
-    double d;
-    std::memcpy(&d, &b, 8);
-    return d;
-  }
-  std::size_t position() const { return pos_; }
-
- private:
-  const std::vector<std::uint8_t>& bytes_;
-  std::size_t end_;
-  std::size_t pos_ = 0;
-};
 
 std::string hex64(std::uint64_t v) {
   char s[17];
@@ -104,27 +57,26 @@ bool valid_section_name(const std::string& name) {
 std::uint32_t scheme_code(PredictScheme p) { return p == PredictScheme::linear ? 0u : 1u; }
 
 std::vector<std::uint8_t> encode_details(const ShapeModel& m, const std::vector<int>& counts) {
-  ByteWriter w;
-  for (char c : kMagic) w.bytes.push_back(static_cast<std::uint8_t>(c));
-  w.u32(kDetailsVersion);
-  w.u32(scheme_code(m.wavelet.predict));
-  w.u32(m.wavelet.update ? 1u : 0u);
-  w.u32(m.wavelet.frame == DetailFrame::local ? 1u : 0u);
-  w.f64(m.wavelet.degenerate_frame_tolerance);
-  w.u32(static_cast<std::uint32_t>(m.levels()));
-  w.u32(static_cast<std::uint32_t>(m.base.rows()));
-  w.u32(static_cast<std::uint32_t>(m.base_faces.rows()));
-  w.u32(0);
-  for (int n : counts) w.u32(static_cast<std::uint32_t>(n));
+  ByteWriter w(std::vector<std::uint8_t>(kMagic, kMagic + 8));
+  w.put<std::uint32_t>(kDetailsVersion);
+  w.put<std::uint32_t>(scheme_code(m.wavelet.predict));
+  w.put<std::uint32_t>(m.wavelet.update ? 1u : 0u);
+  w.put<std::uint32_t>(m.wavelet.frame == DetailFrame::local ? 1u : 0u);
+  w.put<double>(m.wavelet.degenerate_frame_tolerance);
+  w.put<std::uint32_t>(static_cast<std::uint32_t>(m.levels()));
+  w.put<std::uint32_t>(static_cast<std::uint32_t>(m.base.rows()));
+  w.put<std::uint32_t>(static_cast<std::uint32_t>(m.base_faces.rows()));
+  w.put<std::uint32_t>(0);
+  for (int n : counts) w.put<std::uint32_t>(static_cast<std::uint32_t>(n));
   for (Eigen::Index f = 0; f < m.base_faces.rows(); ++f)
-    for (int k = 0; k < 3; ++k) w.i32(m.base_faces(f, k));
+    for (int k = 0; k < 3; ++k) w.put<std::int32_t>(m.base_faces(f, k));
   for (Eigen::Index v = 0; v < m.base.rows(); ++v)
-    for (int k = 0; k < 3; ++k) w.f64(m.base(v, k));
+    for (int k = 0; k < 3; ++k) w.put<double>(m.base(v, k));
   for (const RowMatrixX3d& D : m.details)
     for (Eigen::Index v = 0; v < D.rows(); ++v)
-      for (int k = 0; k < 3; ++k) w.f64(D(v, k));
-  w.u64(fnv1a64(w.bytes.data(), w.bytes.size()));
-  return std::move(w.bytes);
+      for (int k = 0; k < 3; ++k) w.put<double>(D(v, k));
+  w.put<std::uint64_t>(fnv1a64(w.bytes().data(), w.bytes().size()));
+  return w.take();
 }
 
 /// Parses details.bin into the model; every defect is an InputError naming the file.
@@ -133,17 +85,17 @@ void decode_details(const std::vector<std::uint8_t>& bytes, const std::string& w
   const auto fail = [&](const std::string& why) { return InputError(where + " " + why + "; rebuild the model"); };
   if (bytes.size() < kHeaderBytes + 8) throw fail("is truncated (" + std::to_string(bytes.size()) + " bytes, shorter than its header)");
   if (std::memcmp(bytes.data(), kMagic, 8) != 0) throw fail("is not a mrsnake details file (bad magic bytes)");
-  ByteReader r(bytes, bytes.size());
-  r.u64();  // magic
-  const std::uint32_t version = r.u32();
+  ByteReader r(bytes, 0, fail("is truncated").what());
+  r.get<std::uint64_t>();  // magic
+  const std::uint32_t version = r.get<std::uint32_t>();
   if (version > kDetailsVersion)
     throw InputError(where + " has format version " + std::to_string(version) + ", newer than this mrsnake reads (" +
                      std::to_string(kDetailsVersion) + "); upgrade mrsnake or rebuild the model");
   if (version == 0) throw fail("has an invalid format version 0");
-  const std::uint32_t predict = r.u32(), update = r.u32(), frame = r.u32();
-  const double tolerance = r.f64();
-  const std::uint32_t levels = r.u32(), n0 = r.u32(), m0 = r.u32();
-  r.u32();  // reserved
+  const std::uint32_t predict = r.get<std::uint32_t>(), update = r.get<std::uint32_t>(), frame = r.get<std::uint32_t>();
+  const double tolerance = r.get<double>();
+  const std::uint32_t levels = r.get<std::uint32_t>(), n0 = r.get<std::uint32_t>(), m0 = r.get<std::uint32_t>();
+  r.get<std::uint32_t>();  // reserved
   if (predict > 1 || update > 1 || frame > 1 || !(tolerance >= 0 && tolerance < 1))
     throw fail("has an unknown wavelet scheme code");
   if (levels > kMaxLevels) throw fail("claims " + std::to_string(levels) + " levels (at most " + std::to_string(kMaxLevels) + ")");
@@ -154,7 +106,7 @@ void decode_details(const std::vector<std::uint8_t>& bytes, const std::string& w
   counts.assign(levels + 1, 0);
   std::uint64_t previous = 0;
   for (std::uint32_t j = 0; j <= levels; ++j) {
-    const std::uint32_t n = r.u32();
+    const std::uint32_t n = r.get<std::uint32_t>();
     if (n <= previous || n > 2000000000u) throw fail("has vertex counts that do not grow with the level");
     counts[j] = static_cast<int>(n);
     previous = n;
@@ -176,19 +128,19 @@ void decode_details(const std::vector<std::uint8_t>& bytes, const std::string& w
   m.base_faces.resize(m0, 3);
   for (std::uint32_t f = 0; f < m0; ++f)
     for (int k = 0; k < 3; ++k) {
-      const std::int32_t v = r.i32();
+      const std::int32_t v = r.get<std::int32_t>();
       if (v < 0 || static_cast<std::uint32_t>(v) >= n0) throw fail("has a base face with a vertex index out of range");
       m.base_faces(f, k) = v;
     }
   m.base.resize(n0, 3);
   for (std::uint32_t v = 0; v < n0; ++v)
-    for (int k = 0; k < 3; ++k) m.base(v, k) = r.f64();
+    for (int k = 0; k < 3; ++k) m.base(v, k) = r.get<double>();
   m.details.assign(levels, RowMatrixX3d());
   for (std::uint32_t j = 1; j <= levels; ++j) {
     RowMatrixX3d& D = m.details[j - 1];
     D.resize(counts[j] - counts[j - 1], 3);
     for (Eigen::Index v = 0; v < D.rows(); ++v)
-      for (int k = 0; k < 3; ++k) D(v, k) = r.f64();
+      for (int k = 0; k < 3; ++k) D(v, k) = r.get<double>();
     if (!D.allFinite()) throw fail("holds non-finite details at level " + std::to_string(j));
   }
   if (!m.base.allFinite()) throw fail("holds non-finite base positions");
