@@ -29,22 +29,27 @@ void print_json(const nlohmann::json& j) { std::cout << json_text(j, 2) << std::
 
 void add_sphere_map_option(CLI::App& command, SphereMap& map) {
   command
-      .add_option("--sphere-map", map,
-                  "Closed surfaces: 'auto' (the default: halves from " + std::to_string(ParameterizationOptions{}.halves_from_faces) +
-                      " faces, punctured below, hierarchical where those fail), 'halves' (cut in two disks across a "
-                      "principal plane, one solve per core), 'punctured' (one vertex removed, one solve) or 'hierarchical' "
-                      "(coarse to fine from a tetrahedron: long protrusions keep their area)")
-      ->transform(CLI::CheckedTransformer(std::map<std::string, SphereMap>{
-          {"auto", SphereMap::automatic}, {"halves", SphereMap::two_halves}, {"punctured", SphereMap::punctured}, {"hierarchical", SphereMap::hierarchical}}))
+      .add_option(
+          "--sphere-map", map,
+          "Closed surfaces: 'auto' (the default: halves from " +
+              std::to_string(ParameterizationOptions{}.halves_from_faces) +
+              " faces, punctured below, hierarchical where those fail), 'halves' (cut in two disks across a "
+              "principal plane, one solve per core), 'punctured' (one vertex removed, one solve) or 'hierarchical' "
+              "(coarse to fine from a tetrahedron: long protrusions keep their area)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, SphereMap>{{"auto", SphereMap::automatic},
+                                                                           {"halves", SphereMap::two_halves},
+                                                                           {"punctured", SphereMap::punctured},
+                                                                           {"hierarchical", SphereMap::hierarchical}}))
       ->option_text("auto|halves|punctured|hierarchical");
 }
 
 void add_fit_rounds_option(CLI::App& command, int& rounds) {
   command
-      .add_option("--fit-rounds", rounds,
-                  "Rounds of the least-squares fit of the finest level to the input along the vertex normals (default " +
-                      std::to_string(rounds) + "; 0 = off: every vertex stays on the input; the full method only, " +
-                      "not with --strict or --no-relax)")
+      .add_option(
+          "--fit-rounds", rounds,
+          "Rounds of the least-squares fit of the finest level to the input along the vertex normals (default " +
+              std::to_string(rounds) + "; 0 = off: every vertex stays on the input; the full method only, " +
+              "not with --strict or --no-relax)")
       ->check(CLI::Range(0, 100));
 }
 

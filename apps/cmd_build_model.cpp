@@ -46,9 +46,10 @@ std::string poor_fit_message(const LabelFit& fit, const StructureScale& scale, c
             " voxels) changed its shape: fill the tunnels in the label volume, or give --close-tunnels 0 to see them";
   } else if (c.mc_spacing > 0 && c.spacing_given) {
     char text[200];
-    std::snprintf(text, sizeof text, "; the marching-cubes spacing %.3g mm is coarse for a structure of radius %.3g mm: "
-                  "give a smaller --mc-spacing (e.g. %.3g)", c.mc_spacing, scale.equivalent_radius_mm,
-                  scale.finest_voxel_mm);
+    std::snprintf(text, sizeof text,
+                  "; the marching-cubes spacing %.3g mm is coarse for a structure of radius %.3g mm: "
+                  "give a smaller --mc-spacing (e.g. %.3g)",
+                  c.mc_spacing, scale.equivalent_radius_mm, scale.finest_voxel_mm);
     cause = text;
   } else {
     cause = "; the label may be too thin or ragged for a closed genus-0 model: check it with 'mrsnake mc'";
@@ -112,23 +113,27 @@ void add_build_model_command(CLI::App& app) {
     std::string profile_alignment = "auto";
   };
   auto a = std::make_shared<Args>();
-  cmd->add_option("--labels", a->labels, "Label volume (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)")->required();
+  cmd->add_option("--labels", a->labels, "Label volume (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)")
+      ->required();
   cmd->add_option("--label", a->label, "Label value of the object")->required();
   cmd->add_option("-o,--output", a->output, "Output model folder (replaced if it is already a model)")->required();
-  auto* levels = cmd->add_option("--levels", a->levels, "Number of levels L (1:4 splits of the base mesh)")->check(CLI::Range(1, 10));
-  auto* faces = cmd->add_option("--faces", a->faces,
-                                "Wanted face count of the finest level (default: triangles with edges of half the surface's "
-                                "sampling length, the marching-cubes spacing or the finest voxel, 1024 to 32768)")
-                    ->check(CLI::Range(16, 50000000));
+  auto* levels = cmd->add_option("--levels", a->levels, "Number of levels L (1:4 splits of the base mesh)")
+                     ->check(CLI::Range(1, 10));
+  auto* faces =
+      cmd->add_option("--faces", a->faces,
+                      "Wanted face count of the finest level (default: triangles with edges of half the surface's "
+                      "sampling length, the marching-cubes spacing or the finest voxel, 1024 to 32768)")
+          ->check(CLI::Range(16, 50000000));
   levels->excludes(faces);
   add_sphere_map_option(*cmd, a->sphere_map);
   add_fit_rounds_option(*cmd, a->fit_rounds);
   cmd->add_option("--predict", a->predict, "Wavelet predict step: butterfly (default) or linear")
       ->check(CLI::IsMember({"butterfly", "linear"}));
-  auto* smooth = cmd->add_option("--smooth", a->smooth,
-                                 "Windowed-sinc smoothing iterations of the marching-cubes surface (default 5, or 20 with "
-                                 "--mc-spacing 0 to remove the voxel staircase; 0 = none)")
-                     ->check(CLI::Range(0, 1000));
+  auto* smooth =
+      cmd->add_option("--smooth", a->smooth,
+                      "Windowed-sinc smoothing iterations of the marching-cubes surface (default 5, or 20 with "
+                      "--mc-spacing 0 to remove the voxel staircase; 0 = none)")
+          ->check(CLI::Range(0, 1000));
   cmd->add_option("--mc-spacing", a->mc_spacing,
                   "Marching cubes on the label's Gaussian-smoothed occupancy resampled to this isotropic spacing in mm "
                   "(default: the structure's equivalent radius / 60 if the voxels are finer than that, else 0): a "
@@ -140,15 +145,17 @@ void add_build_model_command(CLI::App& app) {
                   "is (as 'mrsnake mc --close-tunnels'; default 3: a label's stray tunnels of a voxel or two are "
                   "closed with a warning, and the fit check refuses a closing that changed the shape); 0 = no repair")
       ->check(CLI::Range(0, 20));
-  cmd->add_option("--component", a->component,
-                  "Model only the label's K-th largest connected part (1 = the largest), e.g. one of a left and a right "
-                  "organ that share a label; its other parts count as background, in the appearance too; 0 = the "
-                  "whole label (its largest surface is modelled)")
+  cmd->add_option(
+         "--component", a->component,
+         "Model only the label's K-th largest connected part (1 = the largest), e.g. one of a left and a right "
+         "organ that share a label; its other parts count as background, in the appearance too; 0 = the "
+         "whole label (its largest surface is modelled)")
       ->check(CLI::Range(0, 1000));
-  auto* image_option = cmd->add_option("--image", a->image,
-                  "Reference intensity image of the labels (same physical space): stores the appearance "
-                  "(profiles along the normals, inside/outside statistics) that 'mrsnake segment' matches, and a "
-                  "crop of the image around the organ that 'mrsnake segment --init register' registers to a new image");
+  auto* image_option = cmd->add_option(
+      "--image", a->image,
+      "Reference intensity image of the labels (same physical space): stores the appearance "
+      "(profiles along the normals, inside/outside statistics) that 'mrsnake segment' matches, and a "
+      "crop of the image around the organ that 'mrsnake segment --init register' registers to a new image");
   cmd->add_option("--profile-alignment", a->profile_alignment,
                   "Where the profiles of --image are centred: 'edges' (the image's edge within half a voxel step of "
                   "the label's surface: the label's rounding does not pass into the segmentations), 'labels' (the "
@@ -213,7 +220,8 @@ void add_build_model_command(CLI::App& app) {
     if (!surface.dropped_component_faces.empty())
       warn("label " + std::to_string(a->label) + " has " + std::to_string(surface.components_found) +
            " connected surfaces; the model uses the largest" +
-           (a->component > 0 ? std::string() : std::string(" (--component K models the K-th largest part of the label)")));
+           (a->component > 0 ? std::string()
+                             : std::string(" (--component K models the K-th largest part of the label)")));
     if (surface.closing_radius > 0)
       warn("label " + std::to_string(a->label) + " had a genus-" + std::to_string(surface.genus_before_repair) +
            " surface; closed its tunnels with a radius of " + std::to_string(surface.closing_radius) + " voxels");
@@ -251,7 +259,8 @@ void add_build_model_command(CLI::App& app) {
     const LabelFit fit = fit_to_source(hierarchy.mesh(hierarchy.connectivity.levels()), labels, a->label,
                                        !surface.dropped_component_faces.empty() && a->component == 0);
     if (!(fit.dice >= kMinLabelFitDice)) {
-      const SurfaceChoices choices{mc_spacing, a->mc_spacing >= 0, a->faces > 0 || a->levels > 0, surface.closing_radius};
+      const SurfaceChoices choices{mc_spacing, a->mc_spacing >= 0, a->faces > 0 || a->levels > 0,
+                                   surface.closing_radius};
       if (!a->allow_poor_fit)
         throw AlgorithmError(poor_fit_message(fit, scale, choices) + ", or give --allow-poor-fit to keep it");
       warn(poor_fit_message(fit, scale, choices));
@@ -286,12 +295,12 @@ void add_build_model_command(CLI::App& app) {
     const int L = hierarchy.connectivity.levels();
     quality["finest_level_quality"] = mesh_quality(hierarchy.mesh(L));
     quality["input_faces"] = surface.mesh.num_faces();
-    quality["marching_cubes"] = {{"spacing_mm", mc_spacing},
-                                 {"smoothing_iterations", smoothing},
-                                 {"faces", surface.mesh.num_faces()}};
+    quality["marching_cubes"] = {
+        {"spacing_mm", mc_spacing}, {"smoothing_iterations", smoothing}, {"faces", surface.mesh.num_faces()}};
     model.remesh_quality = quality;
-    model.scale = scale_record(scale, mc_spacing, smoothing, static_cast<int>(hierarchy.connectivity.faces.back().rows()),
-                               a->image.empty() ? std::nullopt : std::optional<double>(reference_margin_mm), fit);
+    model.scale =
+        scale_record(scale, mc_spacing, smoothing, static_cast<int>(hierarchy.connectivity.faces.back().rows()),
+                     a->image.empty() ? std::nullopt : std::optional<double>(reference_margin_mm), fit);
     // The manifest records every stage up to the write; the write's own time is printed.
     model.timings = timings;
 
@@ -328,7 +337,11 @@ void add_build_model_command(CLI::App& app) {
     for (const auto& [stage, seconds] : timings) stages.push_back({{"stage", stage}, {"seconds", seconds}});
     nlohmann::json stats = nlohmann::json::array();
     for (const DetailStats& s : model.detail_stats)
-      stats.push_back({{"level", s.level}, {"count", s.count}, {"rms", s.rms}, {"max", s.max}, {"energy", s.energy},
+      stats.push_back({{"level", s.level},
+                       {"count", s.count},
+                       {"rms", s.rms},
+                       {"max", s.max},
+                       {"energy", s.energy},
                        {"degenerate_frames", s.degenerate_frames}});
     const auto& conn = hierarchy.connectivity;
     if (a->json) {
@@ -350,15 +363,17 @@ void add_build_model_command(CLI::App& app) {
     std::cout << a->output << ": " << L << " levels, " << conn.vertex_counts.back() << " vertices and "
               << conn.faces.back().rows() << " faces at the finest level (input surface: " << surface.mesh.num_faces()
               << " faces)\n";
-    std::printf("  structure %.4g mm3 (equivalent radius %.3g mm); finest level against the label: Dice %.4f, "
-                "volume %+.1f %%\n",
-                scale.volume_mm3, scale.equivalent_radius_mm, fit.dice, 100.0 * (fit.volume_ratio - 1.0));
+    std::printf(
+        "  structure %.4g mm3 (equivalent radius %.3g mm); finest level against the label: Dice %.4f, "
+        "volume %+.1f %%\n",
+        scale.volume_mm3, scale.equivalent_radius_mm, fit.dice, 100.0 * (fit.volume_ratio - 1.0));
     if (alignment)
-      std::printf("  profiles centred on the %s (step residual %.3f; %d level%s moved, mean shift %+.3f mm, mean "
-                  "|shift| %.3f mm)\n",
-                  alignment->to_edges ? "image's edges" : "label's surface", alignment->step_residual,
-                  alignment->levels_aligned, alignment->levels_aligned == 1 ? "" : "s", alignment->mean_shift_mm,
-                  alignment->mean_abs_shift_mm);
+      std::printf(
+          "  profiles centred on the %s (step residual %.3f; %d level%s moved, mean shift %+.3f mm, mean "
+          "|shift| %.3f mm)\n",
+          alignment->to_edges ? "image's edges" : "label's surface", alignment->step_residual,
+          alignment->levels_aligned, alignment->levels_aligned == 1 ? "" : "s", alignment->mean_shift_mm,
+          alignment->mean_abs_shift_mm);
     std::cout << "  level  detail rms (mm)  detail max (mm)\n";
     for (const DetailStats& s : model.detail_stats) std::printf("  %5d  %15.4g  %15.4g\n", s.level, s.rms, s.max);
     std::fflush(stdout);

@@ -14,7 +14,8 @@
 namespace mrsnake::cli {
 
 void add_evaluate_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("evaluate", "Score a segmentation against a truth: Dice, Jaccard, volume difference, ASSD, HD95, Hausdorff");
+  auto* cmd = app.add_subcommand(
+      "evaluate", "Score a segmentation against a truth: Dice, Jaccard, volume difference, ASSD, HD95, Hausdorff");
   struct Args {
     std::string seg, truth, seg_mesh, truth_mesh;
     int label = 1;
@@ -40,7 +41,8 @@ void add_evaluate_command(CLI::App& app) {
       "  mrsnake evaluate --seg-mesh result.vtp --truth-mesh case7/truth.vtp");
   cmd->callback([cmd, a] {
     if (a->seg.empty() && a->seg_mesh.empty())
-      throw CLI::ValidationError("evaluate", "give --seg and --truth (volumes), or --seg-mesh and --truth-mesh (surfaces), or both");
+      throw CLI::ValidationError(
+          "evaluate", "give --seg and --truth (volumes), or --seg-mesh and --truth-mesh (surfaces), or both");
     nlohmann::json j = nlohmann::json::object();
     SegmentationScores scores;
     SurfaceDistance surface;
@@ -65,8 +67,10 @@ void add_evaluate_command(CLI::App& app) {
     auto mm = [](double x) {
       std::ostringstream s;
       s << std::fixed << std::setprecision(3);
-      if (std::isfinite(x)) s << x << " mm";
-      else s << "inf (the segmentation is empty)";
+      if (std::isfinite(x))
+        s << x << " mm";
+      else
+        s << "inf (the segmentation is empty)";
       return s.str();
     };
     if (!a->seg.empty())

@@ -22,7 +22,8 @@ void add_mc_command(CLI::App& app) {
     bool json = false;
   };
   auto a = std::make_shared<Args>();
-  cmd->add_option("--labels", a->labels, "Label volume (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)")->required();
+  cmd->add_option("--labels", a->labels, "Label volume (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)")
+      ->required();
   cmd->add_option("--label", a->label, "Label value to extract")->required();
   cmd->add_option("-o,--output", a->output, "Output mesh (.vtp .vtk .stl .ply .obj .off)")->required();
   cmd->add_option("--smooth", a->smooth, "Windowed-sinc smoothing iterations (volume-preserving); 0 = none")
@@ -39,9 +40,10 @@ void add_mc_command(CLI::App& app) {
                   "spacing in mm (as 'mrsnake build-model --mc-spacing'); 0 = the voxels' own surface (default)")
       ->check(CLI::Range(0.0, 100.0));
   cmd->add_flag("--json", a->json, "Print a JSON summary");
-  cmd->footer("Example: mrsnake mc --labels liver-labels.nii.gz --label 255 --smooth 20 -o liver.vtp\n"
-              "The surface build-model uses by default: mrsnake mc --labels liver-labels.nii.gz --label 255 --spacing 1.2 "
-              "--smooth 5 -o liver-1.2mm.vtp");
+  cmd->footer(
+      "Example: mrsnake mc --labels liver-labels.nii.gz --label 255 --smooth 20 -o liver.vtp\n"
+      "The surface build-model uses by default: mrsnake mc --labels liver-labels.nii.gz --label 255 --spacing 1.2 "
+      "--smooth 5 -o liver-1.2mm.vtp");
   cmd->callback([a] {
     const auto progress = terminal_progress();
     report(progress, "reading " + a->labels, 0.0);
@@ -60,8 +62,8 @@ void add_mc_command(CLI::App& app) {
         sizes += (sizes.empty() ? "" : ", ") + std::to_string(dropped[i]);
       if (dropped.size() > 5) sizes += ", ...";
       warn("label " + std::to_string(a->label) + " has " + std::to_string(surface.components_found) +
-           " connected surfaces; kept the largest and dropped " + std::to_string(surface.dropped_component_faces.size()) +
-           " (largest dropped, in faces: " + sizes + ")");
+           " connected surfaces; kept the largest and dropped " +
+           std::to_string(surface.dropped_component_faces.size()) + " (largest dropped, in faces: " + sizes + ")");
     }
     if (surface.closing_radius > 0)
       warn("label " + std::to_string(a->label) + " had a genus-" + std::to_string(surface.genus_before_repair) +

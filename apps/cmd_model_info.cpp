@@ -23,7 +23,8 @@ std::string format(const char* fmt, double v) {
 }  // namespace
 
 void add_model_info_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("model-info", "Print a shape model's manifest and check that its details rebuild the finest level");
+  auto* cmd = app.add_subcommand("model-info",
+                                 "Print a shape model's manifest and check that its details rebuild the finest level");
   auto model_path = std::make_shared<std::string>();
   auto json = std::make_shared<bool>(false);
   cmd->add_option("MODEL", *model_path, "Model folder (made by 'mrsnake build-model')")->required();
@@ -64,7 +65,10 @@ void add_model_info_command(CLI::App& app) {
                                 {"seconds", seconds},
                                 {"ok", ok}};
     if (*json) {
-      print_json({{"model", *model_path}, {"manifest", manifest}, {"synthesis", synthesis}, {"reference_image", reference},
+      print_json({{"model", *model_path},
+                  {"manifest", manifest},
+                  {"synthesis", synthesis},
+                  {"reference_image", reference},
                   {"appearance", appearance}});
     } else {
       std::cout << *model_path << ": mrsnake model, format version " << manifest["format_version"] << '\n';
@@ -88,7 +92,8 @@ void add_model_info_command(CLI::App& app) {
       const auto& fc = manifest["face_counts"];
       for (int j = 0; j <= model.levels(); ++j) {
         std::printf("  %5d %10d %10d", j, vc[j].get<int>(), fc[j].get<int>());
-        if (j > 0) std::printf("   %15.6g   %15.6g", model.detail_stats.at(j - 1).rms, model.detail_stats.at(j - 1).max);
+        if (j > 0)
+          std::printf("   %15.6g   %15.6g", model.detail_stats.at(j - 1).rms, model.detail_stats.at(j - 1).max);
         std::printf("\n");
       }
       std::fflush(stdout);
@@ -99,7 +104,8 @@ void add_model_info_command(CLI::App& app) {
                                       : model.remesh_quality;
         std::cout << "  remesh quality   ";
         for (const char* key : {"min_angle_deg", "q_min", "q_mean", "pct_valence6_interior", "edge_length_cv"})
-          if (q.contains(key) && q[key].is_number()) std::cout << ' ' << key << ' ' << format("%.3g", q[key].get<double>());
+          if (q.contains(key) && q[key].is_number())
+            std::cout << ' ' << key << ' ' << format("%.3g", q[key].get<double>());
         std::cout << '\n';
       }
       if (model.scale.is_object()) {

@@ -47,8 +47,8 @@ void print_distance(const std::string& reference, const SurfaceDistance& d) {
 }  // namespace
 
 void add_quality_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand(
-      "quality", "Print a mesh's triangle quality and valence, and its distance to a reference mesh");
+  auto* cmd = app.add_subcommand("quality",
+                                 "Print a mesh's triangle quality and valence, and its distance to a reference mesh");
   auto mesh_path = std::make_shared<std::string>();
   auto reference_path = std::make_shared<std::string>();
   auto json = std::make_shared<bool>(false);

@@ -26,20 +26,23 @@ void add_remesh_command(CLI::App& app) {
     bool no_relax = false, strict = false, json = false, compare_unrelaxed = false;
   };
   auto args = std::make_shared<Args>();
-  cmd->add_option("MESH", args->mesh, "Input surface (.vtp .vtk .stl .ply .obj .off): a disk or a closed genus-0 surface")
+  cmd->add_option("MESH", args->mesh,
+                  "Input surface (.vtp .vtk .stl .ply .obj .off): a disk or a closed genus-0 surface")
       ->required();
   cmd->add_option("-o,--output", args->out, "Output folder")->required();
-  auto* levels = cmd->add_option("--levels", args->options.levels, "Number of 1:4 splits L (base of --base-vertices vertices)")
-                     ->check(CLI::Range(1, 10));
-  auto* faces = cmd->add_option("--faces", args->options.target_faces, "Wanted face count of the finest level (default 16000)")
-                    ->check(CLI::Range(16, 50000000));
+  auto* levels =
+      cmd->add_option("--levels", args->options.levels, "Number of 1:4 splits L (base of --base-vertices vertices)")
+          ->check(CLI::Range(1, 10));
+  auto* faces =
+      cmd->add_option("--faces", args->options.target_faces, "Wanted face count of the finest level (default 16000)")
+          ->check(CLI::Range(16, 50000000));
   levels->excludes(faces);
   cmd->add_option("--base-vertices", args->options.base_vertices, "Base mesh size with --levels (default 32)")
       ->check(CLI::Range(6, 100000))
       ->needs(levels);
   auto* no_relax = cmd->add_flag("--no-relax", args->no_relax, "Split without relaxation (the paper's baseline)");
-  auto* strict = cmd->add_flag("--strict", args->strict,
-                               "Relax only the new vertices of each level (the paper's exact method)");
+  auto* strict =
+      cmd->add_flag("--strict", args->strict, "Relax only the new vertices of each level (the paper's exact method)");
   no_relax->excludes(strict);
   add_fit_rounds_option(*cmd, args->options.fit_rounds);
   add_sphere_map_option(*cmd, args->options.sphere_map);
@@ -59,7 +62,9 @@ void add_remesh_command(CLI::App& app) {
     require_replaceable(args->out, earlier);
     const TriMesh input = read_mesh(args->mesh);
     RemeshOptions options = args->options;
-    options.relax = args->no_relax ? RelaxMode::none : args->strict ? RelaxMode::new_vertices_only : RelaxMode::all_vertices;
+    options.relax = args->no_relax ? RelaxMode::none
+                    : args->strict ? RelaxMode::new_vertices_only
+                                   : RelaxMode::all_vertices;
     if (!global_options().quiet) options.progress = terminal_progress();
     const RemeshResult result = remesh(input, options);
     nlohmann::json report = remesh_report(result, options);
@@ -106,8 +111,8 @@ void add_remesh_command(CLI::App& app) {
       }
       table << std::setw(9) << level.flipped_triangles << std::setw(9) << level.seconds << '\n';
     }
-    std::cout << table.str() << "wrote " << result.levels.size() << " levels and report.json and report.html to " << args->out
-              << '\n';
+    std::cout << table.str() << "wrote " << result.levels.size() << " levels and report.json and report.html to "
+              << args->out << '\n';
   });
 }
 

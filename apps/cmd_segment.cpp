@@ -239,7 +239,8 @@ std::pair<SnakeModel, double> load_snake_model(const std::string& path) {
 }  // namespace
 
 void add_segment_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("segment", "Segment a volume with a shape model: coarse-to-fine snake, labels, surfaces and a report");
+  auto* cmd = app.add_subcommand(
+      "segment", "Segment a volume with a shape model: coarse-to-fine snake, labels, surfaces and a report");
   struct Args {
     SegmentCase c;
     std::string model;
@@ -249,10 +250,12 @@ void add_segment_command(CLI::App& app) {
   auto a = std::make_shared<Args>();
   cmd->add_option("--image", a->c.image, "Volume to segment (.nii.gz .nrrd .mha ..., or a DICOM folder)")->required();
   cmd->add_option("--model", a->model, "Shape model folder (made by 'mrsnake build-model')")->required();
-  cmd->add_option("-o,--output", a->c.output, "Output folder: surface.vtp, labels.nii.gz, levels/level_j.vtp, report.json, report.html")
+  cmd->add_option("-o,--output", a->c.output,
+                  "Output folder: surface.vtp, labels.nii.gz, levels/level_j.vtp, report.json, report.html")
       ->required();
   a->snake.add_to(cmd);
-  cmd->add_option("--truth", a->c.truth, "Truth labels on the image's grid: adds the scores of 'mrsnake evaluate' to the report");
+  cmd->add_option("--truth", a->c.truth,
+                  "Truth labels on the image's grid: adds the scores of 'mrsnake evaluate' to the report");
   cmd->add_option("--truth-label", a->c.truth_label, "Label of the object in --truth")->capture_default_str();
   cmd->add_flag("--json", a->json, "Print the report as JSON on stdout");
   cmd->footer(
@@ -307,7 +310,8 @@ std::vector<std::string> case_names(const std::vector<std::string>& images) {
     if (p.filename().empty()) p = p.parent_path();  // a folder given with a trailing slash
     Entry e;
     e.name = p.filename().string();
-    if (std::error_code ec; !std::filesystem::is_directory(p, ec)) {  // a DICOM folder's name (a UID, 1.2.840...) is kept whole
+    if (std::error_code ec;
+        !std::filesystem::is_directory(p, ec)) {  // a DICOM folder's name (a UID, 1.2.840...) is kept whole
       if (e.name.size() > 3 && e.name.compare(e.name.size() - 3, 3, ".gz") == 0) e.name.resize(e.name.size() - 3);
       if (const auto dot = e.name.rfind('.'); dot != std::string::npos && dot > 0) e.name.resize(dot);
     }
@@ -326,7 +330,8 @@ std::vector<std::string> case_names(const std::vector<std::string>& images) {
     if (members.size() < 2) continue;
     const auto prefix = [&](std::size_t i, std::size_t depth) {
       std::string text;
-      for (std::size_t d = std::min(depth, entries[i].parents.size()); d > 0; --d) text += entries[i].parents[d - 1] + "_";
+      for (std::size_t d = std::min(depth, entries[i].parents.size()); d > 0; --d)
+        text += entries[i].parents[d - 1] + "_";
       return text;
     };
     std::size_t deepest = 0;
@@ -386,8 +391,9 @@ std::string batch_csv(const nlohmann::json& cases) {
            c["status"].get<std::string>() + "," + csv_number(c.value("volume_mm3", nlohmann::json())) + "," +
            csv_number(c.value("compute_seconds", nlohmann::json())) + "," +
            csv_number(c.value("load_seconds", nlohmann::json())) + "," + csv_number(c["wall_seconds"]) + "," +
-           (c.contains("self_intersections") ? std::to_string(c["self_intersections"].get<int>()) : std::string()) + "," +
-           csv_field(c.value("init_used", std::string())) + "," + csv_field(c.value("registration", std::string())) + "," +
+           (c.contains("self_intersections") ? std::to_string(c["self_intersections"].get<int>()) : std::string()) +
+           "," + csv_field(c.value("init_used", std::string())) + "," +
+           csv_field(c.value("registration", std::string())) + "," +
            (c.contains("suspect") ? std::string(c["suspect"].get<bool>() ? "true" : "false") : std::string()) + "," +
            csv_field(c.value("reason", std::string())) + "," + csv_field(c.value("error", std::string())) + "\n";
   }
@@ -484,7 +490,8 @@ void run_batch_in_processes(int jobs, const std::vector<std::string>& images, co
         if (getppid() != batch) _exit(1);
         for (std::size_t i = static_cast<std::size_t>(w); i < images.size(); i += static_cast<std::size_t>(jobs)) {
           const std::string line =
-              json_text({{"index", i}, {"row", batch_row(images[i], outputs[i], model, model_path, options, {})}}) + "\n";
+              json_text({{"index", i}, {"row", batch_row(images[i], outputs[i], model, model_path, options, {})}}) +
+              "\n";
           for (std::size_t sent = 0; sent < line.size();) {
             const ssize_t n = write(fds[1], line.data() + sent, line.size() - sent);
             if (n < 0 && errno == EINTR) continue;
@@ -560,7 +567,8 @@ void run_batch_in_processes(int jobs, const std::vector<std::string>& images, co
 
 void add_segment_batch_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
-      "segment-batch", "Segment many volumes with one shape model, read once: a folder per image and a summary (batch.json, batch.csv)");
+      "segment-batch",
+      "Segment many volumes with one shape model, read once: a folder per image and a summary (batch.json, batch.csv)");
   struct Args {
     std::vector<std::string> images;
     std::string model, output, list;
@@ -570,7 +578,8 @@ void add_segment_batch_command(CLI::App& app) {
   };
   auto a = std::make_shared<Args>();
   cmd->add_option("images", a->images, "Volumes to segment (.nii.gz .nrrd .mha ..., or DICOM folders)");
-  cmd->add_option("--list", a->list, "A text file of volumes to segment, one path per line (# comments; relative to the file)");
+  cmd->add_option("--list", a->list,
+                  "A text file of volumes to segment, one path per line (# comments; relative to the file)");
   cmd->add_option("--model", a->model, "Shape model folder (made by 'mrsnake build-model')")->required();
   cmd->add_option("-o,--output", a->output,
                   "Output folder: DIR/NAME/ per image (as 'mrsnake segment' writes it), DIR/batch.json, DIR/batch.csv")
@@ -623,7 +632,10 @@ void add_segment_batch_command(CLI::App& app) {
         warn(position + name + " failed: " + row["error"].get<std::string>());
       }
       rows[i] = std::move(row);
-      summary = {{"model", a->model}, {"model_load_seconds", model_seconds}, {"jobs", a->jobs}, {"cases", nlohmann::json::array()}};
+      summary = {{"model", a->model},
+                 {"model_load_seconds", model_seconds},
+                 {"jobs", a->jobs},
+                 {"cases", nlohmann::json::array()}};
       for (const nlohmann::json& r : rows)
         if (!r.is_null()) summary["cases"].push_back(r);
       summary["succeeded"] = finished - failed;

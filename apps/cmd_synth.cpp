@@ -26,7 +26,8 @@ std::array<T, 3> parse_triple(const std::string& text, const std::string& option
   while (std::getline(ss, item, ',')) {
     std::istringstream is(item);
     T v{};
-    if (!(is >> v) || !(is >> std::ws).eof()) throw CLI::ValidationError(option, "'" + text + "' is not 1 or 3 comma-separated numbers");
+    if (!(is >> v) || !(is >> std::ws).eof())
+      throw CLI::ValidationError(option, "'" + text + "' is not 1 or 3 comma-separated numbers");
     values.push_back(v);
   }
   if (values.size() == 1) return {values[0], values[0], values[0]};
@@ -53,9 +54,11 @@ Volume label_mask(const Volume& labels, int label) {
 }  // namespace
 
 void add_synth_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("synth", "Write a synthetic volume with an exactly known truth: image, label, surface and parameters");
+  auto* cmd = app.add_subcommand(
+      "synth", "Write a synthetic volume with an exactly known truth: image, label, surface and parameters");
   struct Args {
-    std::string out, shape = "sphere", size = "64", spacing = "1", noise = "gaussian", contrast = "200,50", pose = "none";
+    std::string out, shape = "sphere", size = "64", spacing = "1", noise = "gaussian", contrast = "200,50",
+                     pose = "none";
     std::string from_image, from_labels, params;
     double snr = 10, blur = 0.5, bias = 0, deform = 0;
     int label = 1, supersampling = 4, component = 0;
@@ -63,8 +66,11 @@ void add_synth_command(CLI::App& app) {
     bool json = false;
   };
   auto a = std::make_shared<Args>();
-  cmd->add_option("-o,--output", a->out, "Output folder: image.nii.gz, truth.nii.gz, truth.vtp, params.json")->required();
-  cmd->add_option("--shape", a->shape, "sphere, ellipsoid, blob (random star-shaped), aneurysm (vessel with a sac), heart (cavity in a thick wall)")
+  cmd->add_option("-o,--output", a->out, "Output folder: image.nii.gz, truth.nii.gz, truth.vtp, params.json")
+      ->required();
+  cmd->add_option(
+         "--shape", a->shape,
+         "sphere, ellipsoid, blob (random star-shaped), aneurysm (vessel with a sac), heart (cavity in a thick wall)")
       ->check(CLI::IsMember({"sphere", "ellipsoid", "blob", "aneurysm", "heart"}))
       ->capture_default_str();
   cmd->add_option("--size", a->size, "Voxels: N or NX,NY,NZ")->capture_default_str();
@@ -74,22 +80,29 @@ void add_synth_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--snr", a->snr, "|foreground - background| / noise sigma; <= 0 for no noise")->capture_default_str();
   cmd->add_option("--blur", a->blur, "Gaussian blur sigma in mm (0: none)")->capture_default_str();
-  cmd->add_option("--bias", a->bias, "Strength B of a smooth multiplicative bias field within [e^-B, e^B] (0: none)")->capture_default_str();
+  cmd->add_option("--bias", a->bias, "Strength B of a smooth multiplicative bias field within [e^-B, e^B] (0: none)")
+      ->capture_default_str();
   cmd->add_option("--contrast", a->contrast, "Foreground,background intensities")->capture_default_str();
-  cmd->add_option("--pose", a->pose, "random: a random similarity (rotation <= 15 deg, shift <= 5% of the field of view, scale 0.9-1.1)")
+  cmd->add_option("--pose", a->pose,
+                  "random: a random similarity (rotation <= 15 deg, shift <= 5% of the field of view, scale 0.9-1.1)")
       ->check(CLI::IsMember({"none", "random"}))
       ->capture_default_str();
-  cmd->add_option("--deform", a->deform, "Largest displacement in mm of a random smooth deformation (0: none)")->capture_default_str();
+  cmd->add_option("--deform", a->deform, "Largest displacement in mm of a random smooth deformation (0: none)")
+      ->capture_default_str();
   cmd->add_option("--seed", a->seed, "Random seed: the same seed gives the same case")->capture_default_str();
-  cmd->add_option("--supersampling", a->supersampling, "Partial volume: N^3 samples per boundary voxel")->capture_default_str();
-  auto* from_image = cmd->add_option("--from-image", a->from_image, "Warp this real image instead of rendering a shape (adds no noise or blur unless --noise, --snr or --blur is given)");
+  cmd->add_option("--supersampling", a->supersampling, "Partial volume: N^3 samples per boundary voxel")
+      ->capture_default_str();
+  auto* from_image = cmd->add_option("--from-image", a->from_image,
+                                     "Warp this real image instead of rendering a shape (adds no noise or blur unless "
+                                     "--noise, --snr or --blur is given)");
   auto* from_labels = cmd->add_option("--from-labels", a->from_labels, "The label volume of --from-image");
   cmd->add_option("--label", a->label, "The label of --from-labels that becomes the truth")->capture_default_str();
-  auto* component = cmd->add_option("--component", a->component,
-                                    "Only the label's K-th largest connected part becomes the truth (1 = the largest; as "
-                                    "'build-model --component'); 0 = all of it")
-                        ->check(CLI::Range(0, 1000))
-                        ->capture_default_str();
+  auto* component =
+      cmd->add_option("--component", a->component,
+                      "Only the label's K-th largest connected part becomes the truth (1 = the largest; as "
+                      "'build-model --component'); 0 = all of it")
+          ->check(CLI::Range(0, 1000))
+          ->capture_default_str();
   component->needs(from_labels);
   auto* params = cmd->add_option("--params", a->params, "Regenerate the case recorded in this params.json");
   from_image->needs(from_labels);
@@ -98,7 +111,8 @@ void add_synth_command(CLI::App& app) {
   cmd->add_flag("--json", a->json, "Print a JSON summary");
   cmd->footer(
       "Examples:\n"
-      "  mrsnake synth --shape blob --size 96 --spacing 1,1,1.5 --noise rician --snr 5 --pose random --deform 3 --seed 7 -o case7\n"
+      "  mrsnake synth --shape blob --size 96 --spacing 1,1,1.5 --noise rician --snr 5 --pose random --deform 3 --seed "
+      "7 -o case7\n"
       "  mrsnake synth --from-image ct.nii.gz --from-labels seg.nii.gz --label 5 --deform 4 -o liver-warped\n"
       "  mrsnake synth --params case7/params.json -o case7-again");
   cmd->callback([cmd, a] {
@@ -110,11 +124,11 @@ void add_synth_command(CLI::App& app) {
       return o.source_component > 0 ? keep_label_part(labels, o.source_label, o.source_component) : labels;
     };
     if (!a->params.empty()) {
-      for (const char* option : {"--shape", "--size", "--spacing", "--noise", "--snr", "--blur", "--bias", "--contrast", "--pose",
-                                 "--deform", "--seed", "--supersampling", "--label", "--component"})
+      for (const char* option : {"--shape", "--size", "--spacing", "--noise", "--snr", "--blur", "--bias", "--contrast",
+                                 "--pose", "--deform", "--seed", "--supersampling", "--label", "--component"})
         if (cmd->count(option) > 0)
-          throw CLI::ValidationError(option, "--params regenerates the recorded case as it was; drop " + std::string(option) +
-                                                 " or drop --params");
+          throw CLI::ValidationError(option, "--params regenerates the recorded case as it was; drop " +
+                                                 std::string(option) + " or drop --params");
       params = synth_params_from_json(read_json_file(a->params));
     } else {
       SynthOptions o;
@@ -139,13 +153,16 @@ void add_synth_command(CLI::App& app) {
           numbers = numbers && (is >> v) && (is >> std::ws).eof();
           fb.push_back(v);
         }
-        if (!numbers || fb.size() != 2) throw CLI::ValidationError("--contrast", "give two intensities: FOREGROUND,BACKGROUND, e.g. 200,50");
+        if (!numbers || fb.size() != 2)
+          throw CLI::ValidationError("--contrast", "give two intensities: FOREGROUND,BACKGROUND, e.g. 200,50");
         o.foreground = fb[0];
         o.background = fb[1];
       } else {
         for (const char* option : {"--shape", "--size", "--spacing", "--contrast", "--supersampling"})
           if (cmd->count(option) > 0)
-            throw CLI::ValidationError(option, std::string(option) + " does not apply to --from-image, which keeps the grid and intensities of the image");
+            throw CLI::ValidationError(
+                option, std::string(option) +
+                            " does not apply to --from-image, which keeps the grid and intensities of the image");
         // A real image already has its noise and blur: add none unless asked.
         if (cmd->count("--noise") == 0 && cmd->count("--snr") == 0) o.noise = SynthNoise::none;
         if (cmd->count("--blur") == 0) o.blur_mm = 0;

@@ -7,7 +7,8 @@
 // the reference image registered to the case, its truth warped onto the case's grid.
 //
 // Usage: bench_segment [--quick] [--real DATA_DIR] [--mrsnake BIN] [--work DIR] [--json OUT] [--keep]
-//                      [--only CASE_SUBSTRING] [--gac PROPAGATION,CURVATURE,ADVECTION[,SIGMA_MM,BETA_FRACTION,ALPHA_DIVISOR]]
+//                      [--only CASE_SUBSTRING] [--gac
+//                      PROPAGATION,CURVATURE,ADVECTION[,SIGMA_MM,BETA_FRACTION,ALPHA_DIVISOR]]
 //                      [--elastix-atlas SCRIPT]
 //   --keep also writes each level set's labels into the work folder.
 //   default: synthetic cases at 128³ and 256³; --quick: 128³ only;
@@ -70,7 +71,9 @@ std::string read_text(const fs::path& path) {
   return ss.str();
 }
 
-std::string tail(const std::string& s, std::size_t n = 1500) { return s.size() <= n ? s : "..." + s.substr(s.size() - n); }
+std::string tail(const std::string& s, std::size_t n = 1500) {
+  return s.size() <= n ? s : "..." + s.substr(s.size() - n);
+}
 
 /// Runs f in a forked child (its exit code is the child's); wall time and peak RSS via wait4.
 ChildResult run_forked(const std::function<int()>& f) {
@@ -250,9 +253,9 @@ struct Bench {
   bool keep_labels = false;
   std::string primary_init;              ///< --init of the snake whose start the level sets share (empty: default)
   std::vector<std::string> extra_inits;  ///< also run the snake with these --init modes
-  std::string only;  ///< run only the cases whose name contains this
-  std::string elastix_atlas;  ///< the bench/elastix_atlas script; empty: no elastix column
-  std::string elastix_skipped;  ///< why there is no elastix column (empty: it runs, or no real data)
+  std::string only;                      ///< run only the cases whose name contains this
+  std::string elastix_atlas;             ///< the bench/elastix_atlas script; empty: no elastix column
+  std::string elastix_skipped;           ///< why there is no elastix column (empty: it runs, or no real data)
   bench::LevelSetOptions itk_options;
   std::vector<Row> rows;
   std::vector<InitRow> init_rows;
@@ -269,8 +272,8 @@ struct Bench {
   /// Builds a model from labels (and the image, for the appearance, if build-model takes it).
   int build_model(const fs::path& labels, int label, const fs::path& image, const fs::path& model,
                   const std::vector<std::string>& extra) {
-    std::vector<std::string> args{"build-model", "--labels", labels.string(), "--label", std::to_string(label), "-o",
-                                  model.string(), "--json"};
+    std::vector<std::string> args{"build-model",         "--labels", labels.string(), "--label",
+                                  std::to_string(label), "-o",       model.string(),  "--json"};
     if (model_takes_image) {
       args.push_back("--image");
       args.push_back(image.string());
@@ -280,8 +283,8 @@ struct Bench {
     const ChildResult r = mrsnake_cmd(args, dir, model.filename().string() + "-build");
     const json summary = json::parse(read_text(dir / (model.filename().string() + "-build.out")));
     std::printf("  model %s: %d levels, %d faces, built in %.1f s (peak %.0f MiB)\n",
-                (model.parent_path().filename() / model.filename()).c_str(),
-                summary["levels"].get<int>(), summary["faces"].get<int>(), r.wall_seconds, r.peak_mib);
+                (model.parent_path().filename() / model.filename()).c_str(), summary["levels"].get<int>(),
+                summary["faces"].get<int>(), r.wall_seconds, r.peak_mib);
     return summary["levels"].get<int>();
   }
 
@@ -357,8 +360,9 @@ struct Bench {
     } else {
       // The synth truth holds the structure (or its modelled part) as label 1.
       const std::string warped = row.record.value("warped_labels", std::string());
-      const ChildResult e = mrsnake_cmd({"evaluate", "--seg", warped, "--truth", c.truth.string(), "--label", "1", "--json"},
-                                        c.dir, "evaluate-elastix", false);
+      const ChildResult e =
+          mrsnake_cmd({"evaluate", "--seg", warped, "--truth", c.truth.string(), "--label", "1", "--json"}, c.dir,
+                      "evaluate-elastix", false);
       if (e.exit_code == 0)
         row.scores = scores_from(json::parse(read_text(c.dir / "evaluate-elastix.out")));
       else
@@ -379,8 +383,8 @@ struct Bench {
     const fs::path seg = c.dir / "seg", init = c.dir / "init";
     std::vector<std::string> init_args;
     if (!primary_init.empty()) init_args = {"--init", primary_init};
-    std::vector<std::string> seg_args{"segment", "--image", c.image.string(), "--model", c.model.string(), "-o",
-                                      seg.string(), "--json"};
+    std::vector<std::string> seg_args{"segment",        "--image", c.image.string(), "--model",
+                                      c.model.string(), "-o",      seg.string(),     "--json"};
     seg_args.insert(seg_args.end(), init_args.begin(), init_args.end());
     const ChildResult r = mrsnake_cmd(seg_args, c.dir, "segment", false);
     json report;
@@ -410,8 +414,8 @@ struct Bench {
     // initially posed S_0 follows the similarity, so the finest level is the posed S_L).
     std::printf(", initial surface");
     std::fflush(stdout);
-    std::vector<std::string> start_args{"segment", "--image", c.image.string(), "--model", c.model.string(), "-o",
-                                        init.string(), "--max-iterations", "0", "--json"};
+    std::vector<std::string> start_args{"segment", "--image",     c.image.string(),   "--model", c.model.string(),
+                                        "-o",      init.string(), "--max-iterations", "0",       "--json"};
     start_args.insert(start_args.end(), init_args.begin(), init_args.end());
     const ChildResult ri = mrsnake_cmd(start_args, c.dir, "init", false);
     if (ri.exit_code != 0) {
@@ -539,7 +543,9 @@ struct Bench {
   }
 
   void print_table() const {
-    std::printf("\n| case | method | Dice | ASSD mm | HD95 mm | seconds (compute) | load s | peak MiB | speed-up vs best ITK |\n");
+    std::printf(
+        "\n| case | method | Dice | ASSD mm | HD95 mm | seconds (compute) | load s | peak MiB | speed-up vs best ITK "
+        "|\n");
     std::printf("|---|---|---|---|---|---|---|---|---|\n");
     const auto num = [](double v, const char* f) {
       if (std::isnan(v)) return std::string("–");
@@ -555,13 +561,14 @@ struct Bench {
                   num(r.load_seconds, "%.3f").c_str(), num(r.peak_mib, "%.0f").c_str(),
                   std::isnan(r.speedup) ? "" : num(r.speedup, "%.1f×").c_str());
     if (init_rows.empty()) return;
-    std::printf("\nInitialization routes (initial surface: the same run with --max-iterations 0):\n\n"
-                "| case | --init | route taken | initial Dice | final Dice | init s | registration s | registration |\n"
-                "|---|---|---|---|---|---|---|---|\n");
+    std::printf(
+        "\nInitialization routes (initial surface: the same run with --max-iterations 0):\n\n"
+        "| case | --init | route taken | initial Dice | final Dice | init s | registration s | registration |\n"
+        "|---|---|---|---|---|---|---|---|\n");
     for (const InitRow& r : init_rows)
-      std::printf("| %s | %s | %s | %s | %s | %s | %s | %s |\n", r.case_name.c_str(), r.init.c_str(), r.init_used.c_str(),
-                  num(r.initial_dice, "%.4f").c_str(), num(r.final_dice, "%.4f").c_str(), num(r.init_seconds, "%.3f").c_str(),
-                  num(r.register_seconds, "%.3f").c_str(), r.registration.c_str());
+      std::printf("| %s | %s | %s | %s | %s | %s | %s | %s |\n", r.case_name.c_str(), r.init.c_str(),
+                  r.init_used.c_str(), num(r.initial_dice, "%.4f").c_str(), num(r.final_dice, "%.4f").c_str(),
+                  num(r.init_seconds, "%.3f").c_str(), num(r.register_seconds, "%.3f").c_str(), r.registration.c_str());
   }
 
   /// Real data: the snake's primary run beside single-atlas elastix, per case and on average.
@@ -569,10 +576,13 @@ struct Bench {
     std::printf("\nmrsnake (%s, the default) against single-atlas elastix:\n", elastix_rival.c_str());
     if (!elastix_skipped.empty()) std::printf("  elastix column skipped: %s\n", elastix_skipped.c_str());
     if (!elastix_rows.empty()) {
-      std::printf("  elastix: the reference image (the one the model was built from; moving) registered to the case's image\n"
-                  "  (fixed), affine then B-spline, Mattes mutual information, 4 resolutions, 250 / 500 iterations per\n"
-                  "  resolution, 2048 random samples, one thread (bench/elastix_atlas: the parameters of bench/cross_subject);\n"
-                  "  the B-spline grid is FinalGridSpacingInVoxels %d:", kElastixGridVoxels);
+      std::printf(
+          "  elastix: the reference image (the one the model was built from; moving) registered to the case's image\n"
+          "  (fixed), affine then B-spline, Mattes mutual information, 4 resolutions, 250 / 500 iterations per\n"
+          "  resolution, 2048 random samples, one thread (bench/elastix_atlas: the parameters of "
+          "bench/cross_subject);\n"
+          "  the B-spline grid is FinalGridSpacingInVoxels %d:",
+          kElastixGridVoxels);
       std::map<std::string, std::vector<const ElastixRow*>> by_dataset;
       for (const ElastixRow& e : elastix_rows) by_dataset[e.dataset].push_back(&e);
       bool first = true;
@@ -590,17 +600,20 @@ struct Bench {
         std::printf("%s %s at %s's %s voxels", first ? "" : ";", spacing_text(nominal).c_str(), dataset.c_str(),
                     spacing_text(mm).c_str());
         if (laid > 0)
-          std::printf(" (as elastix laid it on the box after the affine: mean %s×%s×%s mm)", cell(grid[0] / laid, "%.1f").c_str(),
-                      cell(grid[1] / laid, "%.1f").c_str(), cell(grid[2] / laid, "%.1f").c_str());
+          std::printf(" (as elastix laid it on the box after the affine: mean %s×%s×%s mm)",
+                      cell(grid[0] / laid, "%.1f").c_str(), cell(grid[1] / laid, "%.1f").c_str(),
+                      cell(grid[2] / laid, "%.1f").c_str());
         first = false;
       }
-      std::printf(".\n  transformix warps the reference truth (the structure's label; for a two-part label only the modelled\n"
-                  "  part, as synth takes it) with nearest neighbour; `mrsnake evaluate` scores it against the case's truth.\n"
-                  "  elastix s: the registration's wall seconds (transformix not included); mrsnake compute s: after\n"
-                  "  loading (report.json); wall s: the whole segment process. Distances in mm.\n");
+      std::printf(
+          ".\n  transformix warps the reference truth (the structure's label; for a two-part label only the modelled\n"
+          "  part, as synth takes it) with nearest neighbour; `mrsnake evaluate` scores it against the case's truth.\n"
+          "  elastix s: the registration's wall seconds (transformix not included); mrsnake compute s: after\n"
+          "  loading (report.json); wall s: the whole segment process. Distances in mm.\n");
     }
-    std::printf("\n| case | mrsnake Dice | ASSD | HD95 | compute s | wall s | elastix Dice | ASSD | HD95 | elastix s |\n"
-                "|---|---|---|---|---|---|---|---|---|---|\n");
+    std::printf(
+        "\n| case | mrsnake Dice | ASSD | HD95 | compute s | wall s | elastix Dice | ASSD | HD95 | elastix s |\n"
+        "|---|---|---|---|---|---|---|---|---|---|\n");
     std::map<std::string, const ElastixRow*> elastix_of;
     for (const ElastixRow& e : elastix_rows) elastix_of[e.case_name] = &e;
     ColumnMean m_dice, m_assd, m_hd95, m_compute, m_wall, e_dice, e_assd, e_hd95, e_seconds;
@@ -632,7 +645,8 @@ struct Bench {
                 m_wall.text("%.2f").c_str(), e_dice.text("%.4f").c_str(), e_assd.text("%.3f").c_str(),
                 e_hd95.text("%.3f").c_str(), e_seconds.text("%.1f").c_str());
     for (const ElastixRow& e : elastix_rows)
-      if (!e.error.empty()) std::printf("elastix failed on %s (scored Dice 0): %s\n", e.case_name.c_str(), e.error.c_str());
+      if (!e.error.empty())
+        std::printf("elastix failed on %s (scored Dice 0): %s\n", e.case_name.c_str(), e.error.c_str());
   }
 
   json elastix_rows_json() const {
@@ -660,9 +674,13 @@ struct Bench {
     json out = json::array();
     const auto val = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
     for (const InitRow& r : init_rows)
-      out.push_back({{"case", r.case_name}, {"init", r.init}, {"init_used", r.init_used},
-                     {"initial_dice", val(r.initial_dice)}, {"final_dice", val(r.final_dice)},
-                     {"init_seconds", val(r.init_seconds)}, {"register_seconds", val(r.register_seconds)},
+      out.push_back({{"case", r.case_name},
+                     {"init", r.init},
+                     {"init_used", r.init_used},
+                     {"initial_dice", val(r.initial_dice)},
+                     {"final_dice", val(r.final_dice)},
+                     {"init_seconds", val(r.init_seconds)},
+                     {"register_seconds", val(r.register_seconds)},
                      {"registration", r.registration}});
     return out;
   }
@@ -676,7 +694,8 @@ struct Bench {
       const bool has_best = r.extra.contains("best_itk_dice");
       double best_dice = -1;
       for (const Row& o : rows)
-        if (o.case_name == r.case_name && o.method.rfind("itk_", 0) == 0) best_dice = std::max(best_dice, o.scores.dice);
+        if (o.case_name == r.case_name && o.method.rfind("itk_", 0) == 0)
+          best_dice = std::max(best_dice, o.scores.dice);
       const bool dice_ok = r.scores.dice >= best_dice;
       const bool speed_ok = has_best && r.speedup >= 20;
       json t{{"case", r.case_name}, {"dice_at_least_best_itk", dice_ok}, {"speedup_at_least_20", speed_ok}};
@@ -742,11 +761,13 @@ void synthetic_cases(Bench& b, bool quick) {
       const std::string tag = shape + "-" + std::to_string(size.voxels);
       const auto case_name = [&](double snr, bool posed) {
         char name[96];
-        std::snprintf(name, sizeof name, "%s %d³ SNR %g %s", shape.c_str(), size.voxels, snr, posed ? "posed" : "centred");
+        std::snprintf(name, sizeof name, "%s %d³ SNR %g %s", shape.c_str(), size.voxels, snr,
+                      posed ? "posed" : "centred");
         return std::string(name);
       };
       bool wanted = b.only.empty();
-      for (const Variant& v : size.variants) wanted = wanted || case_name(v.snr, v.posed).find(b.only) != std::string::npos;
+      for (const Variant& v : size.variants)
+        wanted = wanted || case_name(v.snr, v.posed).find(b.only) != std::string::npos;
       if (!wanted) continue;
       const fs::path mdir = b.work / ("model-" + tag);
       fs::create_directories(mdir);
@@ -758,29 +779,39 @@ void synthetic_cases(Bench& b, bool quick) {
       const int levels = b.build_model(mdir / "case" / "truth.nii.gz", 1, mdir / "case" / "image.nii.gz", model,
                                        {"--levels", std::to_string(size.levels)});
       for (std::size_t vi = 0; vi < size.variants.size(); ++vi) {
-          const double snr = size.variants[vi].snr;
-          const bool posed = size.variants[vi].posed;
-          // The same case whatever --only selects.
-          const int case_seed = size.voxels * 100 + (shape == "blob" ? 0 : 50) + static_cast<int>(vi);
-          Case c;
-          c.name = case_name(snr, posed);
-          if (!b.only.empty() && c.name.find(b.only) == std::string::npos) continue;
-          c.dir = b.work / (tag + "-snr" + std::to_string(static_cast<int>(snr)) + (posed ? "-posed" : "-centred"));
-          fs::create_directories(c.dir);
-          std::vector<std::string> args{"synth", "--shape", shape, "--size", std::to_string(size.voxels), "--snr",
-                                        std::to_string(snr), "--deform", deform, "--seed", std::to_string(case_seed),
-                                        "-o", (c.dir / "case").string()};
-          if (posed) {
-            args.push_back("--pose");
-            args.push_back("random");
-          }
-          b.mrsnake_cmd(args, c.dir, "synth");
-          c.image = c.dir / "case" / "image.nii.gz";
-          c.truth = c.dir / "case" / "truth.nii.gz";
-          c.model = model;
-          c.model_levels = levels;
-          b.run_case(c);
+        const double snr = size.variants[vi].snr;
+        const bool posed = size.variants[vi].posed;
+        // The same case whatever --only selects.
+        const int case_seed = size.voxels * 100 + (shape == "blob" ? 0 : 50) + static_cast<int>(vi);
+        Case c;
+        c.name = case_name(snr, posed);
+        if (!b.only.empty() && c.name.find(b.only) == std::string::npos) continue;
+        c.dir = b.work / (tag + "-snr" + std::to_string(static_cast<int>(snr)) + (posed ? "-posed" : "-centred"));
+        fs::create_directories(c.dir);
+        std::vector<std::string> args{"synth",
+                                      "--shape",
+                                      shape,
+                                      "--size",
+                                      std::to_string(size.voxels),
+                                      "--snr",
+                                      std::to_string(snr),
+                                      "--deform",
+                                      deform,
+                                      "--seed",
+                                      std::to_string(case_seed),
+                                      "-o",
+                                      (c.dir / "case").string()};
+        if (posed) {
+          args.push_back("--pose");
+          args.push_back("random");
         }
+        b.mrsnake_cmd(args, c.dir, "synth");
+        c.image = c.dir / "case" / "image.nii.gz";
+        c.truth = c.dir / "case" / "truth.nii.gz";
+        c.model = model;
+        c.model_levels = levels;
+        b.run_case(c);
+      }
     }
 }
 
@@ -794,8 +825,12 @@ void real_cases(Bench& b, const fs::path& data) {
   };
   const fs::path v = data / "volumes";
   const std::vector<Structure> structures{
-      {"liver (abdomen-ct-small, label 5)", "abdomen-ct-small.nii.gz", "abdomen-ct-small-seg.nii.gz", 5,
-       {"--close-tunnels", "3"}, "6"},
+      {"liver (abdomen-ct-small, label 5)",
+       "abdomen-ct-small.nii.gz",
+       "abdomen-ct-small-seg.nii.gz",
+       5,
+       {"--close-tunnels", "3"},
+       "6"},
       {"fourth ventricle (MRIcrop, label 3)", "MRIcrop-orig.gipl.gz", "MRIcrop-seg.gipl.gz", 3, {}, "2"},
       {"right hippocampus (MRIcrop, label 4)", "MRIcrop-orig.gipl.gz", "MRIcrop-seg.gipl.gz", 4, {}, "2"},
       {"left hippocampus (MRIcrop, label 5)", "MRIcrop-orig.gipl.gz", "MRIcrop-seg.gipl.gz", 5, {}, "2"},
@@ -824,9 +859,20 @@ void real_cases(Bench& b, const fs::path& data) {
     model_options.insert(model_options.end(), part.begin(), part.end());
     c.model_levels = b.build_model(v / s.labels, s.label, v / s.image, c.model, model_options);
     // A new case: the same image and label, warped by a known random pose and deformation.
-    std::vector<std::string> synth{"synth", "--from-image", (v / s.image).string(), "--from-labels",
-                                   (v / s.labels).string(), "--label", std::to_string(s.label), "--pose", "random",
-                                   "--deform", s.deform_mm, "--seed", std::to_string(seed++), "-o",
+    std::vector<std::string> synth{"synth",
+                                   "--from-image",
+                                   (v / s.image).string(),
+                                   "--from-labels",
+                                   (v / s.labels).string(),
+                                   "--label",
+                                   std::to_string(s.label),
+                                   "--pose",
+                                   "random",
+                                   "--deform",
+                                   s.deform_mm,
+                                   "--seed",
+                                   std::to_string(seed++),
+                                   "-o",
                                    (c.dir / "case").string()};
     synth.insert(synth.end(), part.begin(), part.end());
     b.mrsnake_cmd(synth, c.dir, "synth");
@@ -857,20 +903,31 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (a == "--quick") quick = true;
-    else if (a == "--keep") keep = true;
-    else if (a == "--real") real = value();
-    else if (a == "--mrsnake") mrsnake_bin = value();
-    else if (a == "--work") work = value();
-    else if (a == "--json") json_out = value();
-    else if (a == "--only") only = value();
-    else if (a == "--gac") gac = value();
-    else if (a == "--elastix-atlas") elastix_atlas = value();
+    if (a == "--quick")
+      quick = true;
+    else if (a == "--keep")
+      keep = true;
+    else if (a == "--real")
+      real = value();
+    else if (a == "--mrsnake")
+      mrsnake_bin = value();
+    else if (a == "--work")
+      work = value();
+    else if (a == "--json")
+      json_out = value();
+    else if (a == "--only")
+      only = value();
+    else if (a == "--gac")
+      gac = value();
+    else if (a == "--elastix-atlas")
+      elastix_atlas = value();
     else {
-      std::fprintf(stderr,
-                   "usage: bench_segment [--quick] [--real DATA_DIR] [--mrsnake BIN] [--work DIR] [--json OUT] [--keep]\n"
-                   "                     [--only CASE_SUBSTRING] [--gac PROPAGATION,CURVATURE,ADVECTION[,SIGMA_MM,BETA_FRACTION,ALPHA_DIVISOR]]\n"
-                   "                     [--elastix-atlas SCRIPT]\n");
+      std::fprintf(
+          stderr,
+          "usage: bench_segment [--quick] [--real DATA_DIR] [--mrsnake BIN] [--work DIR] [--json OUT] [--keep]\n"
+          "                     [--only CASE_SUBSTRING] [--gac "
+          "PROPAGATION,CURVATURE,ADVECTION[,SIGMA_MM,BETA_FRACTION,ALPHA_DIVISOR]]\n"
+          "                     [--elastix-atlas SCRIPT]\n");
       return a == "--help" || a == "-h" ? 0 : 2;
     }
   }
@@ -888,8 +945,8 @@ int main(int argc, char** argv) {
   b.only = only;
   if (!gac.empty()) {  // PROPAGATION,CURVATURE,ADVECTION[,SIGMA_MM,BETA_FRACTION,ALPHA_DIVISOR]
     auto& o = b.itk_options;
-    double* fields[] = {&o.gac_propagation, &o.gac_curvature, &o.gac_advection, &o.gac_sigma_mm,
-                        &o.gac_beta_fraction, &o.gac_alpha_divisor};
+    double* fields[] = {&o.gac_propagation, &o.gac_curvature,     &o.gac_advection,
+                        &o.gac_sigma_mm,    &o.gac_beta_fraction, &o.gac_alpha_divisor};
     std::stringstream ss(gac);
     std::string item;
     for (int k = 0; k < 6 && std::getline(ss, item, ','); ++k) *fields[k] = std::stod(item);
@@ -899,7 +956,8 @@ int main(int argc, char** argv) {
   fs::create_directories(b.work);
   {
     const ChildResult h = b.mrsnake_cmd({"build-model", "--help"}, b.work, "build-model-help", false);
-    b.model_takes_image = h.exit_code == 0 && read_text(b.work / "build-model-help.out").find("--image") != std::string::npos;
+    b.model_takes_image =
+        h.exit_code == 0 && read_text(b.work / "build-model-help.out").find("--image") != std::string::npos;
   }
   std::printf("bench_segment: %s, work folder %s; models %s an appearance (build-model --image)\n",
               real.empty() ? (quick ? "synthetic 128³ (quick)" : "synthetic 128³ and 256³") : "real data",

@@ -28,8 +28,8 @@ int main(int argc, char** argv) {
       for (float v : r.truth.data) object += v == kTruthLabel;
       rusage usage{};
       getrusage(RUSAGE_SELF, &usage);
-      std::printf("%-10s %6d %10.2f %10d %12zu %14.1f\n", to_string(shape).c_str(), size, seconds, r.truth_mesh.num_faces(),
-                  object, usage.ru_maxrss / 1024.0);
+      std::printf("%-10s %6d %10.2f %10d %12zu %14.1f\n", to_string(shape).c_str(), size, seconds,
+                  r.truth_mesh.num_faces(), object, usage.ru_maxrss / 1024.0);
     }
   return 0;
 }

@@ -66,8 +66,9 @@ Case octahedron_case(int levels) {
 
 int main() {
   const fs::path dir = fs::temp_directory_path() / ("mrsnake-bench-wavelets-" + std::to_string(getpid()));
-  std::printf("%-10s %-10s %8s %8s | %9s %9s %9s %11s %9s %9s %9s | %8s %8s\n", "faces", "predict", "levels", "vertices",
-              "plan_ms", "anal_ms", "synth_ms", "lastlvl_ms", "save_ms", "load_ms", "model_MB", "err/diag", "peak_MB");
+  std::printf("%-10s %-10s %8s %8s | %9s %9s %9s %11s %9s %9s %9s | %8s %8s\n", "faces", "predict", "levels",
+              "vertices", "plan_ms", "anal_ms", "synth_ms", "lastlvl_ms", "save_ms", "load_ms", "model_MB", "err/diag",
+              "peak_MB");
   for (int levels : {6, 7}) {
     const Case c = octahedron_case(levels);
     for (PredictScheme p : {PredictScheme::linear, PredictScheme::butterfly}) {
@@ -81,7 +82,8 @@ int main() {
       RowMatrixX3d S;
       const double t_synth = best_of(runs, [&] { S = wt.synthesize(a.base, a.details); });
       RowMatrixX3d last;
-      const double t_last = best_of(runs, [&] { last = wt.synthesize_level(levels - 1, a.levels[levels - 1], a.details[levels - 1]); });
+      const double t_last =
+          best_of(runs, [&] { last = wt.synthesize_level(levels - 1, a.levels[levels - 1], a.details[levels - 1]); });
       const double err = (S - c.finest).rowwise().norm().maxCoeff() / bounding_box_diagonal(c.finest);
       const ShapeModel model = make_model(c.conn, c.finest, o);
       const double t_save = best_of(runs, [&] { save_model(dir.string(), model); });
@@ -89,8 +91,9 @@ int main() {
       for (const auto& e : fs::directory_iterator(dir)) bytes += static_cast<double>(fs::file_size(e.path()));
       const double t_load = best_of(runs, [&] { ShapeModel m = load_model(dir.string()); });
       std::printf("%-10ld %-10s %8d %8ld | %9.2f %9.2f %9.2f %11.2f %9.1f %9.1f %9.2f | %8.1e %8.0f\n",
-                  static_cast<long>(c.conn.faces.back().rows()), to_string(p).c_str(), levels, static_cast<long>(c.finest.rows()),
-                  t_plan * 1e3, t_anal * 1e3, t_synth * 1e3, t_last * 1e3, t_save * 1e3, t_load * 1e3, bytes / 1e6, err, peak_mb());
+                  static_cast<long>(c.conn.faces.back().rows()), to_string(p).c_str(), levels,
+                  static_cast<long>(c.finest.rows()), t_plan * 1e3, t_anal * 1e3, t_synth * 1e3, t_last * 1e3,
+                  t_save * 1e3, t_load * 1e3, bytes / 1e6, err, peak_mb());
       if (levels == 7) {
         std::printf("    detail rms per level (mm):");
         for (const DetailStats& s : a.stats) std::printf(" %.2e", s.rms);
@@ -106,8 +109,9 @@ int main() {
   }
   std::error_code ec;
   fs::remove_all(dir, ec);
-  std::printf("plan = stencils and checks (WaveletTransform), anal = full analysis S_L -> S_0 + details,\n"
-              "synth = full synthesis, lastlvl = one synthesis step to the finest level, save/load = the model folder\n"
-              "(load validates every checksum, without reading the .vtp meshes); best of 3-5 runs.\n");
+  std::printf(
+      "plan = stencils and checks (WaveletTransform), anal = full analysis S_L -> S_0 + details,\n"
+      "synth = full synthesis, lastlvl = one synthesis step to the finest level, save/load = the model folder\n"
+      "(load validates every checksum, without reading the .vtp meshes); best of 3-5 runs.\n");
   return 0;
 }

@@ -147,7 +147,8 @@ LevelSetRun geodesic_active_contour(const Volume& image, const Volume& init, con
   sigmoid->Update();
   if (const char* dump = std::getenv("MRSNAKE_BENCH_DUMP_GAC")) {
     Volume f = image;
-    std::copy(sigmoid->GetOutput()->GetBufferPointer(), sigmoid->GetOutput()->GetBufferPointer() + f.num_voxels(), f.data.begin());
+    std::copy(sigmoid->GetOutput()->GetBufferPointer(), sigmoid->GetOutput()->GetBufferPointer() + f.num_voxels(),
+              f.data.begin());
     write_volume(dump, f, VoxelType::float32);
   }
 
@@ -187,8 +188,10 @@ LevelSetRun threshold_level_set(const Volume& image, const Volume& init, const L
   smooth->Update();
   std::vector<float> inside, shell;
   for (std::size_t i = 0; i < image.num_voxels(); ++i) {
-    if (phi[i] < 0) inside.push_back(image.data[i]);
-    else if (phi[i] <= 3.0f) shell.push_back(image.data[i]);
+    if (phi[i] < 0)
+      inside.push_back(image.data[i]);
+    else if (phi[i] <= 3.0f)
+      shell.push_back(image.data[i]);
   }
   const double median = median_of(inside), outside = median_of(shell);
   const double sigma = robust_sigma(inside, median);

@@ -16,8 +16,8 @@ namespace mrsnake::bench {
 struct LevelSetOptions {
   int max_iterations = 200;      ///< evolution steps at most (the start is a few voxels from the boundary)
   double max_rms_change = 0.01;  ///< stop when the RMS change of the level set falls below this
-  double sigma_mm = 1.0;          ///< Gaussian smoothing of the threshold level set's feature image
-  double gac_sigma_mm = 1.5;      ///< scale of the GAC's gradient magnitude (recursive Gaussian)
+  double sigma_mm = 1.0;         ///< Gaussian smoothing of the threshold level set's feature image
+  double gac_sigma_mm = 1.5;     ///< scale of the GAC's gradient magnitude (recursive Gaussian)
   // Geodesic active contour: speed g = sigmoid(|∇(G_σ * I)|), edges → 0, flat regions → 1.
   double gac_propagation = 0.3, gac_curvature = 1.0, gac_advection = 1.0;
   /// Sigmoid: β = flat + gac_beta_fraction·(edge − flat), α = −(edge − flat)/gac_alpha_divisor,
@@ -36,7 +36,7 @@ struct LevelSetRun {
   double evolution_seconds = 0;  ///< the level set iterations alone
   int iterations = 0;
   double rms_change = 0;
-  std::string parameters_json;   ///< the parameters used (derived ones included), as a JSON object
+  std::string parameters_json;  ///< the parameters used (derived ones included), as a JSON object
 };
 
 /// Sets ITK's global default thread count (1 for the benchmark's one-thread comparison).

@@ -3,10 +3,9 @@
 // its self-intersection count. Snake options can be overridden to compare settings.
 // Usage: bench_snake_levels IMAGE MODEL_DIR TRUTH [--truth-label L] [--init fit] [key=value ...]
 //   keys: membrane, thin_plate, prior, tangential, external, time_step, max_step, smoothing,
-//         max_iterations, min_iterations, patience, range_fraction, min_range_voxels, max_profile_cost, distance_penalty (profile),
-//         edge_distance_penalty, min_gain,
-//         reg_schedule (shrink factors as digits: 421, 42, 21), reg_iterations, reg_samples,
-//         reg_change, reg_window, reg_min_step, reg_step, reg_eval
+//         max_iterations, min_iterations, patience, range_fraction, min_range_voxels, max_profile_cost,
+//         distance_penalty (profile), edge_distance_penalty, min_gain, reg_schedule (shrink factors as digits: 421, 42,
+//         21), reg_iterations, reg_samples, reg_change, reg_window, reg_min_step, reg_step, reg_eval
 #include <ctime>
 #include <cstdio>
 #include <cstdlib>
@@ -25,7 +24,9 @@ using namespace mrsnake;
 
 int main(int argc, char** argv) {
   if (argc < 4) {
-    std::fprintf(stderr, "usage: bench_snake_levels IMAGE MODEL_DIR TRUTH [--truth-label L] [--init MODE] [--force MODE] [key=value ...]\n");
+    std::fprintf(stderr,
+                 "usage: bench_snake_levels IMAGE MODEL_DIR TRUTH [--truth-label L] [--init MODE] [--force MODE] "
+                 "[key=value ...]\n");
     return 2;
   }
   const Volume image = read_volume(argv[1]);
@@ -86,30 +87,50 @@ int main(int argc, char** argv) {
         reg.shrink_factors.push_back(c - '0');
         reg.smoothing_voxels.push_back(0.5 * (c - '0') >= 1 ? 0.5 * (c - '0') : 0.0);
       }
-    } else if (key == "reg_iterations") reg.iterations_per_level = static_cast<int>(v);
-    else if (key == "reg_samples") reg.samples_per_level = static_cast<int>(v);
-    else if (key == "reg_eval") reg.evaluation_samples = static_cast<int>(v);
-    else if (key == "reg_change") reg.min_relative_change = v;
-    else if (key == "reg_window") reg.convergence_window = static_cast<int>(v);
-    else if (key == "reg_min_step") reg.min_step_voxels = v;
-    else if (key == "reg_step") reg.initial_step_voxels = v;
-    else if (key == "smoothing") o.snake.offset_smoothing = static_cast<int>(v);
-    else if (key == "fine_deform") o.fine.deform_edge_centred = v != 0;
-    else if (key == "fine_min_iterations") o.fine.min_iterations = static_cast<int>(v);
-    else if (key == "fine_patience") o.fine.patience = static_cast<int>(v);
-    else if (key == "fine_step") o.fine.profile_step_fraction = v;
-    else if (key == "median") o.snake.offset_median = static_cast<int>(v);
-    else if (key == "undo") o.undo_self_intersections = v != 0;
-    else if (key == "max_iterations") o.snake.max_iterations = static_cast<int>(v);
-    else if (key == "min_iterations") o.snake.min_iterations = static_cast<int>(v);
-    else if (key == "patience") o.snake.patience = static_cast<int>(v);
-    else if (keys.count(key)) *keys[key] = v;
+    } else if (key == "reg_iterations")
+      reg.iterations_per_level = static_cast<int>(v);
+    else if (key == "reg_samples")
+      reg.samples_per_level = static_cast<int>(v);
+    else if (key == "reg_eval")
+      reg.evaluation_samples = static_cast<int>(v);
+    else if (key == "reg_change")
+      reg.min_relative_change = v;
+    else if (key == "reg_window")
+      reg.convergence_window = static_cast<int>(v);
+    else if (key == "reg_min_step")
+      reg.min_step_voxels = v;
+    else if (key == "reg_step")
+      reg.initial_step_voxels = v;
+    else if (key == "smoothing")
+      o.snake.offset_smoothing = static_cast<int>(v);
+    else if (key == "fine_deform")
+      o.fine.deform_edge_centred = v != 0;
+    else if (key == "fine_min_iterations")
+      o.fine.min_iterations = static_cast<int>(v);
+    else if (key == "fine_patience")
+      o.fine.patience = static_cast<int>(v);
+    else if (key == "fine_step")
+      o.fine.profile_step_fraction = v;
+    else if (key == "median")
+      o.snake.offset_median = static_cast<int>(v);
+    else if (key == "undo")
+      o.undo_self_intersections = v != 0;
+    else if (key == "max_iterations")
+      o.snake.max_iterations = static_cast<int>(v);
+    else if (key == "min_iterations")
+      o.snake.min_iterations = static_cast<int>(v);
+    else if (key == "patience")
+      o.snake.patience = static_cast<int>(v);
+    else if (keys.count(key))
+      *keys[key] = v;
     else {
       std::fprintf(stderr, "unknown key %s\n", key.c_str());
       return 2;
     }
   }
-  const auto score = [&](const TriMesh& m) { return evaluate_segmentation(rasterize_mesh(m, truth), truth, 1, truth_label); };
+  const auto score = [&](const TriMesh& m) {
+    return evaluate_segmentation(rasterize_mesh(m, truth), truth, 1, truth_label);
+  };
   SegmentOptions o0 = o;
   o0.snake.max_iterations = 0;
   const SegmentResult r0 = segment(image, model, o0);
@@ -118,7 +139,9 @@ int main(int argc, char** argv) {
   const SegmentResult r = segment(image, model, o);
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c1);
   const double sec = (c1.tv_sec - c0.tv_sec) + 1e-9 * (c1.tv_nsec - c0.tv_nsec);
-  std::printf("| level | vertices | pyramid | voxel mm | range mm | iterations | |offset| mm | rejected | start Dice | Dice | ASSD mm | self-int |\n");
+  std::printf(
+      "| level | vertices | pyramid | voxel mm | range mm | iterations | |offset| mm | rejected | start Dice | Dice | "
+      "ASSD mm | self-int |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (std::size_t j = 0; j < r.levels.size(); ++j) {
     const LevelOutcome& l = r.levels[j];
@@ -130,18 +153,22 @@ int main(int argc, char** argv) {
   }
   std::printf("| stage | seconds |\n|---|---|\n");
   for (const auto& [name, sec] : r.stage_seconds) std::printf("| %s | %.3f |\n", name.c_str(), sec);
-  for (const LevelOutcome& l : r.levels) std::printf("| level %d%s | %.3f |\n", l.level, l.deformed ? "" : " (synthesized)", l.seconds);
+  for (const LevelOutcome& l : r.levels)
+    std::printf("| level %d%s | %.3f |\n", l.level, l.deformed ? "" : " (synthesized)", l.seconds);
   if (r.registration && r.registration->ran) {
     const RegistrationResult& g = r.registration->result;
-    std::printf("registration %s: %.3f s (setup %.3f, evaluation %.3f, optimization %.3f), iterations", r.registration->accepted ? "accepted" : "rejected",
-                r.registration->seconds, g.setup_seconds, g.evaluation_seconds, g.optimization_seconds);
+    std::printf("registration %s: %.3f s (setup %.3f, evaluation %.3f, optimization %.3f), iterations",
+                r.registration->accepted ? "accepted" : "rejected", r.registration->seconds, g.setup_seconds,
+                g.evaluation_seconds, g.optimization_seconds);
     for (const int it : g.iterations) std::printf(" %d", it);
-    std::printf(", metric %.4f -> %.4f, scale %.4f, rotation %.2f deg, stop: %s\n", g.initial_metric, g.final_metric, g.transform.scale,
-                g.transform.angle_deg, g.stop_condition.c_str());
+    std::printf(", metric %.4f -> %.4f, scale %.4f, rotation %.2f deg, stop: %s\n", g.initial_metric, g.final_metric,
+                g.transform.scale, g.transform.angle_deg, g.stop_condition.c_str());
   }
   std::printf("init %s, compute %.3f s\n", to_string(r.init).c_str(), r.compute_seconds);
   const SegmentationScores s0 = score(r0.surface), s = score(r.surface);
-  std::printf("start Dice %.4f ASSD %.3f | final Dice %.4f ASSD %.3f | self-intersections %d | %.3f s CPU (segment() with the final count)\n", s0.dice,
-              s0.assd_mm, s.dice, s.assd_mm, r.self_intersections, sec);
+  std::printf(
+      "start Dice %.4f ASSD %.3f | final Dice %.4f ASSD %.3f | self-intersections %d | %.3f s CPU (segment() with the "
+      "final count)\n",
+      s0.dice, s0.assd_mm, s.dice, s.assd_mm, r.self_intersections, sec);
   return 0;
 }

@@ -36,7 +36,8 @@ int main(int argc, char** argv) {
     o.supersampling = 2;
     return render_synth(draw_synth_params(o));
   };
-  std::printf("preparing %d^3 %s (target seed 101, model seed 102, %d levels)...\n", size, to_string(shape).c_str(), levels);
+  std::printf("preparing %d^3 %s (target seed 101, model seed 102, %d levels)...\n", size, to_string(shape).c_str(),
+              levels);
   const SynthResult target = make(101), ref = make(102);
   ShrinkWrapOptions so;
   so.levels = levels;
@@ -68,7 +69,9 @@ int main(int argc, char** argv) {
   std::printf("| **compute (normalize..levels)** | **%.3f** |\n| segment() incl. self-intersection count | %.3f |\n",
               r.compute_seconds, total);
   std::printf("| segment() thread CPU time (machine load does not count) | %.3f |\n", cpu);
-  std::printf("\n| level | vertices | pyramid | iterations | converged | synthesis s | total s |\n|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "\n| level | vertices | pyramid | iterations | converged | synthesis s | total s "
+      "|\n|---|---|---|---|---|---|---|\n");
   for (const auto& l : r.levels)
     std::printf("| %d | %d | %d | %d | %s | %.3f | %.3f |\n", l.level, l.vertices, l.pyramid_level, l.snake.iterations,
                 l.snake.converged ? "yes" : "no", l.synthesis_seconds, l.seconds);

@@ -76,8 +76,8 @@ extern "C" void on_interrupt(int sig) {
 std::string temp_name_beside(const std::string& final_path) {
   static std::atomic<int> counter{0};
   const fs::path p(final_path);
-  return (p.parent_path() / (".tmp-" + std::to_string(getpid()) + "-" + std::to_string(counter++) + "-" +
-                             p.filename().string()))
+  return (p.parent_path() /
+          (".tmp-" + std::to_string(getpid()) + "-" + std::to_string(counter++) + "-" + p.filename().string()))
       .string();
 }
 

@@ -18,13 +18,21 @@ namespace byte_codec_detail {
 template <std::size_t N>
 struct Unsigned;
 template <>
-struct Unsigned<1> { using type = std::uint8_t; };
+struct Unsigned<1> {
+  using type = std::uint8_t;
+};
 template <>
-struct Unsigned<2> { using type = std::uint16_t; };
+struct Unsigned<2> {
+  using type = std::uint16_t;
+};
 template <>
-struct Unsigned<4> { using type = std::uint32_t; };
+struct Unsigned<4> {
+  using type = std::uint32_t;
+};
 template <>
-struct Unsigned<8> { using type = std::uint64_t; };
+struct Unsigned<8> {
+  using type = std::uint64_t;
+};
 }  // namespace byte_codec_detail
 
 /// Appends values little-endian.

@@ -128,8 +128,8 @@ SurfaceLocator::Hit SurfaceLocator::closest(const Eigen::Vector3d& p) const {
   hit.point = to_eigen(point);
   hit.face = static_cast<int>(std::distance(impl_->triangles.cbegin(), it));
   const TriMesh& m = impl_->mesh;
-  hit.barycentric = barycentric(hit.point, m.V.row(m.F(hit.face, 0)), m.V.row(m.F(hit.face, 1)),
-                                m.V.row(m.F(hit.face, 2)));
+  hit.barycentric =
+      barycentric(hit.point, m.V.row(m.F(hit.face, 0)), m.V.row(m.F(hit.face, 1)), m.V.row(m.F(hit.face, 2)));
   hit.distance = (hit.point - p).norm();
   return hit;
 }
@@ -250,12 +250,18 @@ std::vector<std::pair<int, int>> self_intersecting_face_pairs(const TriMesh& mes
   return out;
 }
 
-int count_self_intersections(const TriMesh& mesh) { return static_cast<int>(self_intersecting_face_pairs(mesh).size()); }
+int count_self_intersections(const TriMesh& mesh) {
+  return static_cast<int>(self_intersecting_face_pairs(mesh).size());
+}
 
 void to_json(nlohmann::json& j, const SurfaceDistance& d) {
   j = nlohmann::json{
-      {"mean_mm", d.mean_mm},       {"rms_mm", d.rms_mm},   {"hausdorff_mm", d.hausdorff_mm},
-      {"mean_pct", d.mean_pct},     {"rms_pct", d.rms_pct}, {"hausdorff_pct", d.hausdorff_pct},
+      {"mean_mm", d.mean_mm},
+      {"rms_mm", d.rms_mm},
+      {"hausdorff_mm", d.hausdorff_mm},
+      {"mean_pct", d.mean_pct},
+      {"rms_pct", d.rms_pct},
+      {"hausdorff_pct", d.hausdorff_pct},
       {"reference_diagonal_mm", d.reference_diagonal_mm},
   };
 }

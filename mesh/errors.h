@@ -11,11 +11,11 @@ namespace mrsnake {
 /// Exit codes of the `mrsnake` command (documented in the README).
 enum class ExitCode : int {
   success = 0,
-  internal = 1,   ///< a bug: an unexpected exception
-  usage = 2,      ///< bad command-line arguments
-  bad_input = 3,  ///< an input file is missing, corrupt, unsupported or of the wrong kind
-  output = 4,     ///< an output could not be written
-  failed = 5,     ///< the algorithm could not produce a valid result from valid input
+  internal = 1,     ///< a bug: an unexpected exception
+  usage = 2,        ///< bad command-line arguments
+  bad_input = 3,    ///< an input file is missing, corrupt, unsupported or of the wrong kind
+  output = 4,       ///< an output could not be written
+  failed = 5,       ///< the algorithm could not produce a valid result from valid input
   some_failed = 6,  ///< a batch ran, but some of its items failed (each is listed with its error)
   interrupted = 130,
 };
@@ -23,8 +23,7 @@ enum class ExitCode : int {
 /// Base class of all mrsnake errors.
 class Error : public std::runtime_error {
  public:
-  explicit Error(const std::string& what, ExitCode code = ExitCode::internal)
-      : std::runtime_error(what), code_(code) {}
+  explicit Error(const std::string& what, ExitCode code = ExitCode::internal) : std::runtime_error(what), code_(code) {}
   ExitCode code() const { return code_; }
 
  private:

@@ -55,8 +55,7 @@ Volume to_volume(const FloatImage* image, const std::string& path) {
     for (int c = 0; c < 3; ++c) v.direction[3 * d + c] = image->GetDirection()(d, c);
     if (!(std::isfinite(v.spacing[d]) && v.spacing[d] > 0))
       throw InputError("'" + path + "' has a non-positive or non-finite voxel spacing; fix the image header");
-    if (!std::isfinite(v.origin[d]))
-      throw InputError("'" + path + "' has a non-finite origin; fix the image header");
+    if (!std::isfinite(v.origin[d])) throw InputError("'" + path + "' has a non-finite origin; fix the image header");
   }
   v.data.assign(image->GetBufferPointer(), image->GetBufferPointer() + v.num_voxels());
   return v;
@@ -131,11 +130,13 @@ VoxelFile voxel_file(const std::string& path) {
     bool compressed = false;
     for (const auto& [key, value] : header_fields(path, '=')) {
       // MetaIO reads a value starting with T, t or 1 as true.
-      if (key == "compresseddata") compressed = !value.empty() && (value[0] == 'T' || value[0] == 't' || value[0] == '1');
+      if (key == "compresseddata")
+        compressed = !value.empty() && (value[0] == 'T' || value[0] == 't' || value[0] == '1');
       if (key == "elementdatafile") data_file = value;
     }
     // "LIST [2D]" and printf-style patterns spread the voxels over several files.
-    if (data_file.empty() || lower_case(data_file).rfind("list", 0) == 0 || data_file.find('%') != std::string::npos) return {};
+    if (data_file.empty() || lower_case(data_file).rfind("list", 0) == 0 || data_file.find('%') != std::string::npos)
+      return {};
     return {lower_case(data_file) == "local" ? path : (folder / data_file).string(), !compressed};
   }
   if (extension == ".nrrd" || extension == ".nhdr") {
@@ -183,7 +184,8 @@ void check_voxel_file_exists(const std::string& path, const VoxelFile& voxels) {
   std::error_code ec;
   if (voxels.path.empty() || voxels.path == path) return;
   if (!std::filesystem::exists(voxels.path, ec))
-    throw InputError("'" + path + "' names the voxel file '" + voxels.path + "', which is missing; copy it beside the header");
+    throw InputError("'" + path + "' names the voxel file '" + voxels.path +
+                     "', which is missing; copy it beside the header");
   if (!std::filesystem::is_regular_file(voxels.path, ec))
     throw InputError("'" + path + "' names the voxel file '" + voxels.path + "', which is not a regular file");
 }
@@ -205,7 +207,8 @@ Volume read_dicom_series(const std::string& dir) {
   names->SetUseSeriesDetails(true);
   names->SetDirectory(dir);
   const auto& series = names->GetSeriesUIDs();
-  if (series.empty()) throw InputError("folder '" + dir + "' holds no DICOM series; give an image file or a DICOM folder");
+  if (series.empty())
+    throw InputError("folder '" + dir + "' holds no DICOM series; give an image file or a DICOM folder");
   auto reader = itk::ImageSeriesReader<FloatImage>::New();
   reader->SetImageIO(itk::GDCMImageIO::New());
   reader->SetFileNames(names->GetFileNames(series.front()));
@@ -218,7 +221,9 @@ Volume read_with_itk(const std::string& path) {
   const VoxelFile voxels = voxel_file(path);
   check_voxel_file_exists(path, voxels);
   auto io = itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::ImageIOFactory::IOFileModeEnum::ReadMode);
-  if (!io) throw InputError("'" + path + "' is not an image format mrsnake reads (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)");
+  if (!io)
+    throw InputError("'" + path +
+                     "' is not an image format mrsnake reads (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)");
   io->SetFileName(path);
   io->ReadImageInformation();
   const unsigned dims = io->GetNumberOfDimensions();

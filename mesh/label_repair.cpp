@@ -92,8 +92,8 @@ Volume keep_label_part(const Volume& labels, int label, int rank) {
     throw InputError("label " + std::to_string(label) + " has no voxel; pick a label that is present with --label");
   if (rank > parts)
     throw InputError("label " + std::to_string(label) + " has " + std::to_string(parts) + " connected part" +
-                     (parts == 1 ? "" : "s") + ", so there is no part " + std::to_string(rank) + "; give --component 1" +
-                     (parts == 1 ? "" : " to " + std::to_string(parts)));
+                     (parts == 1 ? "" : "s") + ", so there is no part " + std::to_string(rank) +
+                     "; give --component 1" + (parts == 1 ? "" : " to " + std::to_string(parts)));
 
   Volume out = labels;
   const unsigned int* p = by_size->GetOutput()->GetBufferPointer();

@@ -40,22 +40,25 @@ void convolve_axis(Volume& v, int d, const std::vector<float>& taps) {
   // Lines along d: indexed by the other two coordinates.
   const int a = d == 0 ? 1 : 0, b = d == 2 ? 1 : 2;
   const std::size_t lines = v.size[a] * v.size[b];
-  parallel_ranges(lines, [&](std::size_t begin, std::size_t end) {
-    std::vector<float> line(static_cast<std::size_t>(n));
-    for (std::size_t l = begin; l < end; ++l) {
-      std::size_t c[3] = {0, 0, 0};
-      c[a] = l % v.size[a];
-      c[b] = l / v.size[a];
-      float* p = v.data.data() + v.index(c[0], c[1], c[2]);
-      for (long i = 0; i < n; ++i) line[i] = p[i * stride];
-      for (long i = 0; i < n; ++i) {
-        float sum = 0;
-        const long lo = std::max(0L, i - radius), hi = std::min(n - 1, i + radius);
-        for (long t = lo; t <= hi; ++t) sum += taps[t - i + radius] * line[t];
-        p[i * stride] = sum;
-      }
-    }
-  }, 64);
+  parallel_ranges(
+      lines,
+      [&](std::size_t begin, std::size_t end) {
+        std::vector<float> line(static_cast<std::size_t>(n));
+        for (std::size_t l = begin; l < end; ++l) {
+          std::size_t c[3] = {0, 0, 0};
+          c[a] = l % v.size[a];
+          c[b] = l / v.size[a];
+          float* p = v.data.data() + v.index(c[0], c[1], c[2]);
+          for (long i = 0; i < n; ++i) line[i] = p[i * stride];
+          for (long i = 0; i < n; ++i) {
+            float sum = 0;
+            const long lo = std::max(0L, i - radius), hi = std::min(n - 1, i + radius);
+            for (long t = lo; t <= hi; ++t) sum += taps[t - i + radius] * line[t];
+            p[i * stride] = sum;
+          }
+        }
+      },
+      64);
 }
 
 }  // namespace
@@ -64,7 +67,8 @@ Volume label_occupancy(const Volume& labels, int label, const OccupancyOptions& 
   if (!(options.spacing_mm > 0)) throw std::invalid_argument("the occupancy grid spacing must be positive");
   const auto target = static_cast<float>(label);
   // Bounding box of the label's voxels.
-  long lo[3] = {static_cast<long>(labels.size[0]), static_cast<long>(labels.size[1]), static_cast<long>(labels.size[2])};
+  long lo[3] = {static_cast<long>(labels.size[0]), static_cast<long>(labels.size[1]),
+                static_cast<long>(labels.size[2])};
   long hi[3] = {-1, -1, -1};
   for (std::size_t k = 0; k < labels.size[2]; ++k)
     for (std::size_t j = 0; j < labels.size[1]; ++j) {
@@ -105,7 +109,8 @@ Volume label_occupancy(const Volume& labels, int label, const OccupancyOptions& 
     throw InputError(std::string("an occupancy grid spacing of ") + text +
                      " (too many to hold); choose a spacing nearer the image's voxel size, e.g. 1.2 mm");
   };
-  refuse_grid(static_cast<double>(crop.size[0]) * static_cast<double>(crop.size[1]) * static_cast<double>(crop.size[2]));
+  refuse_grid(static_cast<double>(crop.size[0]) * static_cast<double>(crop.size[1]) *
+              static_cast<double>(crop.size[2]));
   double output_voxels = 1;
   for (int d = 0; d < 3; ++d)
     output_voxels *= std::floor((static_cast<double>(crop.size[d]) - 1) * crop.spacing[d] / options.spacing_mm) + 1;
@@ -142,21 +147,26 @@ Volume label_occupancy(const Volume& labels, int label, const OccupancyOptions& 
       w1[d].push_back(static_cast<float>(std::clamp(x - static_cast<double>(lo), 0.0, 1.0)));
     }
   }
-  parallel_ranges(out.size[2], [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k)
-      for (std::size_t j = 0; j < out.size[1]; ++j)
-        for (std::size_t i = 0; i < out.size[0]; ++i) {
-          const std::size_t x = i0[0][i], y = i0[1][j], z = i0[2][k];
-          const float fx = w1[0][i], fy = w1[1][j], fz = w1[2][k];
-          const auto c = [&](std::size_t dx, std::size_t dy, std::size_t dz) {
-            return crop.at(x + dx, y + dy, z + dz);
-          };
-          const float c00 = c(0, 0, 0) + fx * (c(1, 0, 0) - c(0, 0, 0)), c10 = c(0, 1, 0) + fx * (c(1, 1, 0) - c(0, 1, 0));
-          const float c01 = c(0, 0, 1) + fx * (c(1, 0, 1) - c(0, 0, 1)), c11 = c(0, 1, 1) + fx * (c(1, 1, 1) - c(0, 1, 1));
-          const float c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
-          out.at(i, j, k) = std::clamp(c0 + fz * (c1 - c0), 0.0f, 1.0f);
-        }
-  }, 1);
+  parallel_ranges(
+      out.size[2],
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t k = begin; k < end; ++k)
+          for (std::size_t j = 0; j < out.size[1]; ++j)
+            for (std::size_t i = 0; i < out.size[0]; ++i) {
+              const std::size_t x = i0[0][i], y = i0[1][j], z = i0[2][k];
+              const float fx = w1[0][i], fy = w1[1][j], fz = w1[2][k];
+              const auto c = [&](std::size_t dx, std::size_t dy, std::size_t dz) {
+                return crop.at(x + dx, y + dy, z + dz);
+              };
+              const float c00 = c(0, 0, 0) + fx * (c(1, 0, 0) - c(0, 0, 0)),
+                          c10 = c(0, 1, 0) + fx * (c(1, 1, 0) - c(0, 1, 0));
+              const float c01 = c(0, 0, 1) + fx * (c(1, 0, 1) - c(0, 0, 1)),
+                          c11 = c(0, 1, 1) + fx * (c(1, 1, 1) - c(0, 1, 1));
+              const float c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
+              out.at(i, j, k) = std::clamp(c0 + fz * (c1 - c0), 0.0f, 1.0f);
+            }
+      },
+      1);
   return out;
 }
 

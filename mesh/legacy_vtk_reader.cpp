@@ -17,9 +17,7 @@ class Parser {
  public:
   Parser(std::string data, std::string path) : data_(std::move(data)), path_(std::move(path)) {}
 
-  [[noreturn]] void fail(const std::string& what) const {
-    throw InputError("legacy VTK file '" + path_ + "' " + what);
-  }
+  [[noreturn]] void fail(const std::string& what) const { throw InputError("legacy VTK file '" + path_ + "' " + what); }
 
   std::string line() {
     if (pos_ >= data_.size()) fail("is truncated");
@@ -98,12 +96,36 @@ class Parser {
   }
 
   double decode(const unsigned char* b, const std::string& type) const {
-    if (type == "float") { float v; std::memcpy(&v, b, 4); return v; }
-    if (type == "double") { double v; std::memcpy(&v, b, 8); return v; }
-    if (type == "int") { std::int32_t v; std::memcpy(&v, b, 4); return v; }
-    if (type == "unsigned_int") { std::uint32_t v; std::memcpy(&v, b, 4); return v; }
-    if (type == "short") { std::int16_t v; std::memcpy(&v, b, 2); return v; }
-    if (type == "unsigned_short") { std::uint16_t v; std::memcpy(&v, b, 2); return v; }
+    if (type == "float") {
+      float v;
+      std::memcpy(&v, b, 4);
+      return v;
+    }
+    if (type == "double") {
+      double v;
+      std::memcpy(&v, b, 8);
+      return v;
+    }
+    if (type == "int") {
+      std::int32_t v;
+      std::memcpy(&v, b, 4);
+      return v;
+    }
+    if (type == "unsigned_int") {
+      std::uint32_t v;
+      std::memcpy(&v, b, 4);
+      return v;
+    }
+    if (type == "short") {
+      std::int16_t v;
+      std::memcpy(&v, b, 2);
+      return v;
+    }
+    if (type == "unsigned_short") {
+      std::uint16_t v;
+      std::memcpy(&v, b, 2);
+      return v;
+    }
     if (type == "char") return static_cast<std::int8_t>(b[0]);
     if (type == "unsigned_char") return b[0];
     std::int64_t v;

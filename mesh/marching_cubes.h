@@ -12,7 +12,7 @@
 namespace mrsnake {
 
 struct LabelSurfaceOptions {
-  int smoothing_iterations = 0;   ///< windowed-sinc iterations (volume-preserving); 0 = none
+  int smoothing_iterations = 0;  ///< windowed-sinc iterations (volume-preserving); 0 = none
   double smoothing_passband = 0.1;
   bool keep_largest_component = true;
   /// When the surface is not genus 0, retry after closing the label (label_repair.h) with
@@ -28,10 +28,10 @@ struct LabelSurfaceOptions {
 /// What was extracted, with anything worth a warning.
 struct LabelSurface {
   TriMesh mesh;
-  int components_found = 0;        ///< connected components before keeping the largest
+  int components_found = 0;                  ///< connected components before keeping the largest
   std::vector<int> dropped_component_faces;  ///< face counts of the dropped components
-  int genus_before_repair = 0;     ///< genus of the surface of the label as given
-  int closing_radius = 0;          ///< closing radius (voxels) that made it genus 0; 0 = none
+  int genus_before_repair = 0;               ///< genus of the surface of the label as given
+  int closing_radius = 0;                    ///< closing radius (voxels) that made it genus 0; 0 = none
 };
 
 /// Extracts the surface of the voxels equal to `label` with discrete flying edges (or of their

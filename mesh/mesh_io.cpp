@@ -83,7 +83,8 @@ TriMesh read_off(const std::string& path) {
     if (!next_line(line)) throw InputError("OFF file '" + path + "' is truncated in its faces");
     std::istringstream s(line);
     long k = 0;
-    if (!(s >> k) || k < 3 || k > 10000) throw InputError("OFF file '" + path + "' has a malformed face " + std::to_string(f));
+    if (!(s >> k) || k < 3 || k > 10000)
+      throw InputError("OFF file '" + path + "' has a malformed face " + std::to_string(f));
     std::vector<int> poly(k);
     for (long c = 0; c < k; ++c)
       if (!(s >> poly[c])) throw InputError("OFF file '" + path + "' has a malformed face " + std::to_string(f));
@@ -98,8 +99,10 @@ void write_off(const std::string& path, const TriMesh& mesh) {
   std::ofstream out(path);
   out.precision(17);
   out << "OFF\n" << mesh.num_vertices() << ' ' << mesh.num_faces() << " 0\n";
-  for (int i = 0; i < mesh.num_vertices(); ++i) out << mesh.V(i, 0) << ' ' << mesh.V(i, 1) << ' ' << mesh.V(i, 2) << '\n';
-  for (int f = 0; f < mesh.num_faces(); ++f) out << "3 " << mesh.F(f, 0) << ' ' << mesh.F(f, 1) << ' ' << mesh.F(f, 2) << '\n';
+  for (int i = 0; i < mesh.num_vertices(); ++i)
+    out << mesh.V(i, 0) << ' ' << mesh.V(i, 1) << ' ' << mesh.V(i, 2) << '\n';
+  for (int f = 0; f < mesh.num_faces(); ++f)
+    out << "3 " << mesh.F(f, 0) << ' ' << mesh.F(f, 1) << ' ' << mesh.F(f, 2) << '\n';
   if (!out) throw OutputError("cannot write '" + path + "'");
 }
 
@@ -127,7 +130,8 @@ std::string file_extension(const std::string& path) {
 
 TriMesh read_mesh(const std::string& path) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw InputError("mesh '" + path + "' does not exist; check the path");
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw InputError("mesh '" + path + "' does not exist; check the path");
   const std::string ext = file_extension(path);
   TriMesh mesh;
   if (ext == ".off") {
@@ -142,9 +146,12 @@ TriMesh read_mesh(const std::string& path) {
     mesh = read_obj(path);
   } else {
     vtkSmartPointer<vtkPolyData> poly;
-    if (ext == ".vtp") poly = read_with<vtkXMLPolyDataReader>(path);
+    if (ext == ".vtp")
+      poly = read_with<vtkXMLPolyDataReader>(path);
 
-    else throw InputError("'" + path + "' has an unknown mesh extension '" + ext + "'; use .vtp .vtk .stl .ply .obj or .off");
+    else
+      throw InputError("'" + path + "' has an unknown mesh extension '" + ext +
+                       "'; use .vtp .vtk .stl .ply .obj or .off");
     if (!poly || poly->GetNumberOfPoints() == 0)
       throw InputError("cannot read a mesh from '" + path + "'; the file may be corrupt, truncated or empty");
     mesh = from_polydata(poly);
@@ -193,7 +200,8 @@ void write_mesh(const std::string& path, const TriMesh& mesh) {
       w->SetInputData(poly);
       ok = w->Write();
     } else {
-      throw OutputError("'" + path + "' has an unknown mesh extension '" + ext + "'; use .vtp .vtk .stl .ply .obj or .off");
+      throw OutputError("'" + path + "' has an unknown mesh extension '" + ext +
+                        "'; use .vtp .vtk .stl .ply .obj or .off");
     }
     if (!ok) throw OutputError("cannot write mesh '" + path + "'");
   }

@@ -45,7 +45,8 @@ TriMesh read_obj(const std::string& path) {
         corners.push_back(static_cast<int>(resolved));
       }
       if (corners.size() < 3) fail("a face needs at least 3 corners");
-      for (std::size_t c = 1; c + 1 < corners.size(); ++c) triangles.emplace_back(corners[0], corners[c], corners[c + 1]);
+      for (std::size_t c = 1; c + 1 < corners.size(); ++c)
+        triangles.emplace_back(corners[0], corners[c], corners[c + 1]);
     }
   }
   TriMesh mesh;

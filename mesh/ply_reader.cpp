@@ -31,9 +31,13 @@ struct Element {
 
 int type_size(Type t) {
   switch (t) {
-    case Type::i8: case Type::u8: return 1;
-    case Type::i16: case Type::u16: return 2;
-    case Type::i32: case Type::u32: case Type::f32: return 4;
+    case Type::i8:
+    case Type::u8: return 1;
+    case Type::i16:
+    case Type::u16: return 2;
+    case Type::i32:
+    case Type::u32:
+    case Type::f32: return 4;
     case Type::f64: return 8;
   }
   return 0;
@@ -41,10 +45,10 @@ int type_size(Type t) {
 
 bool parse_type(const std::string& s, Type& t) {
   static const std::pair<const char*, Type> names[] = {
-      {"char", Type::i8},    {"int8", Type::i8},     {"uchar", Type::u8},   {"uint8", Type::u8},
-      {"short", Type::i16},  {"int16", Type::i16},   {"ushort", Type::u16}, {"uint16", Type::u16},
-      {"int", Type::i32},    {"int32", Type::i32},   {"uint", Type::u32},   {"uint32", Type::u32},
-      {"float", Type::f32},  {"float32", Type::f32}, {"double", Type::f64}, {"float64", Type::f64}};
+      {"char", Type::i8},   {"int8", Type::i8},     {"uchar", Type::u8},   {"uint8", Type::u8},
+      {"short", Type::i16}, {"int16", Type::i16},   {"ushort", Type::u16}, {"uint16", Type::u16},
+      {"int", Type::i32},   {"int32", Type::i32},   {"uint", Type::u32},   {"uint32", Type::u32},
+      {"float", Type::f32}, {"float32", Type::f32}, {"double", Type::f64}, {"float64", Type::f64}};
   for (const auto& [name, type] : names)
     if (s == name) {
       t = type;
@@ -76,12 +80,36 @@ class BodyReader {
     switch (t) {
       case Type::i8: return static_cast<std::int8_t>(o[0]);
       case Type::u8: return o[0];
-      case Type::i16: { std::int16_t v; std::memcpy(&v, o, 2); return v; }
-      case Type::u16: { std::uint16_t v; std::memcpy(&v, o, 2); return v; }
-      case Type::i32: { std::int32_t v; std::memcpy(&v, o, 4); return v; }
-      case Type::u32: { std::uint32_t v; std::memcpy(&v, o, 4); return v; }
-      case Type::f32: { float v; std::memcpy(&v, o, 4); return v; }
-      case Type::f64: { double v; std::memcpy(&v, o, 8); return v; }
+      case Type::i16: {
+        std::int16_t v;
+        std::memcpy(&v, o, 2);
+        return v;
+      }
+      case Type::u16: {
+        std::uint16_t v;
+        std::memcpy(&v, o, 2);
+        return v;
+      }
+      case Type::i32: {
+        std::int32_t v;
+        std::memcpy(&v, o, 4);
+        return v;
+      }
+      case Type::u32: {
+        std::uint32_t v;
+        std::memcpy(&v, o, 4);
+        return v;
+      }
+      case Type::f32: {
+        float v;
+        std::memcpy(&v, o, 4);
+        return v;
+      }
+      case Type::f64: {
+        double v;
+        std::memcpy(&v, o, 8);
+        return v;
+      }
     }
     return 0;
   }
@@ -123,10 +151,14 @@ TriMesh read_ply(const std::string& path) {
     if (word == "format") {
       std::string f;
       s >> f;
-      if (f == "ascii") format = Format::ascii;
-      else if (f == "binary_little_endian") format = Format::binary_le;
-      else if (f == "binary_big_endian") format = Format::binary_be;
-      else fail("has an unknown format '" + f + "'");
+      if (f == "ascii")
+        format = Format::ascii;
+      else if (f == "binary_little_endian")
+        format = Format::binary_le;
+      else if (f == "binary_big_endian")
+        format = Format::binary_be;
+      else
+        fail("has an unknown format '" + f + "'");
     } else if (word == "element") {
       Element e;
       long long count = -1;
@@ -165,7 +197,8 @@ TriMesh read_ply(const std::string& path) {
     if (is_vertex) {
       for (std::size_t k = 0; k < e.properties.size(); ++k)
         for (int c = 0; c < 3; ++c)
-          if (!e.properties[k].is_list && e.properties[k].name == std::string(1, "xyz"[c])) xyz[c] = static_cast<int>(k);
+          if (!e.properties[k].is_list && e.properties[k].name == std::string(1, "xyz"[c]))
+            xyz[c] = static_cast<int>(k);
       if (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0) fail("has no x, y and z vertex properties");
       mesh.V.resize(static_cast<Eigen::Index>(e.count), 3);
       have_vertices = true;

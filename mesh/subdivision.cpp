@@ -58,7 +58,8 @@ SubdivisionConnectivity subdivide_connectivity(const RowMatrixX3i& F0, int n0, i
     conn.vertex_counts.push_back(next);
   }
   conn.parent_edges.resize(static_cast<Eigen::Index>(parents.size()), 2);
-  for (std::size_t i = 0; i < parents.size(); ++i) conn.parent_edges.row(static_cast<Eigen::Index>(i)) = parents[i].transpose();
+  for (std::size_t i = 0; i < parents.size(); ++i)
+    conn.parent_edges.row(static_cast<Eigen::Index>(i)) = parents[i].transpose();
   return conn;
 }
 

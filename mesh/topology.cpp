@@ -31,9 +31,7 @@ bool TopologyReport::is_closed_genus0() const {
   return components == 1 && is_manifold() && boundary_loops == 0 && genus == 0;
 }
 
-bool TopologyReport::is_disk() const {
-  return components == 1 && is_manifold() && boundary_loops == 1 && genus == 0;
-}
+bool TopologyReport::is_disk() const { return components == 1 && is_manifold() && boundary_loops == 1 && genus == 0; }
 
 std::string TopologyReport::describe() const {
   if (faces == 0) return "an empty mesh";
@@ -42,7 +40,8 @@ std::string TopologyReport::describe() const {
   if (is_disk()) return "a disk (one boundary loop)";
   s = std::to_string(components) + (components == 1 ? " component" : " components");
   if (genus) s += ", genus " + std::to_string(genus);
-  s += boundary_loops ? ", " + std::to_string(boundary_loops) + " boundary loop" + (boundary_loops > 1 ? "s" : "") : ", closed";
+  s += boundary_loops ? ", " + std::to_string(boundary_loops) + " boundary loop" + (boundary_loops > 1 ? "s" : "")
+                      : ", closed";
   if (non_manifold_edges) s += ", " + std::to_string(non_manifold_edges) + " non-manifold edges";
   if (non_manifold_vertices) s += ", " + std::to_string(non_manifold_vertices) + " non-manifold vertices";
   return s;
@@ -252,12 +251,18 @@ TriMesh remove_unreferenced_vertices(const TriMesh& mesh) {
 void require_disk_or_sphere(const TopologyReport& r, const std::string& what) {
   if (r.is_disk() || r.is_closed_genus0()) return;
   std::string advice;
-  if (r.faces == 0) advice = "the mesh is empty";
-  else if (r.components > 1) advice = "keep only the largest component (mrsnake mc does this)";
-  else if (!r.is_manifold()) advice = "repair the non-manifold parts first";
-  else if (r.genus > 0) advice = "close the handles (e.g. fill the label volume's tunnels) so it becomes genus 0";
-  else advice = "fill all holes but one, or close the surface";
-  throw TopologyError(what + " is " + r.describe() + ", but only a disk or a closed genus-0 surface can be parameterized; " + advice);
+  if (r.faces == 0)
+    advice = "the mesh is empty";
+  else if (r.components > 1)
+    advice = "keep only the largest component (mrsnake mc does this)";
+  else if (!r.is_manifold())
+    advice = "repair the non-manifold parts first";
+  else if (r.genus > 0)
+    advice = "close the handles (e.g. fill the label volume's tunnels) so it becomes genus 0";
+  else
+    advice = "fill all holes but one, or close the surface";
+  throw TopologyError(what + " is " + r.describe() +
+                      ", but only a disk or a closed genus-0 surface can be parameterized; " + advice);
 }
 
 void to_json(nlohmann::json& j, const TopologyReport& r) {

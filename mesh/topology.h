@@ -15,15 +15,15 @@ struct TopologyReport {
   int vertices = 0;             ///< rows of V
   int referenced_vertices = 0;  ///< vertices used by at least one face
   int faces = 0;
-  int edges = 0;                ///< undirected edges
+  int edges = 0;  ///< undirected edges
   int boundary_edges = 0;
   int boundary_loops = 0;
-  int components = 0;           ///< connected components (through shared vertices)
-  int euler_characteristic = 0; ///< V - E + F over referenced vertices
-  int genus = 0;                ///< total genus, from χ = 2c - 2g - b; meaningful on manifolds
-  int non_manifold_edges = 0;   ///< edges with more than two faces
-  int non_manifold_vertices = 0;///< vertices whose faces form more than one fan
-  int degenerate_faces = 0;     ///< repeated corners or (near) zero area
+  int components = 0;                     ///< connected components (through shared vertices)
+  int euler_characteristic = 0;           ///< V - E + F over referenced vertices
+  int genus = 0;                          ///< total genus, from χ = 2c - 2g - b; meaningful on manifolds
+  int non_manifold_edges = 0;             ///< edges with more than two faces
+  int non_manifold_vertices = 0;          ///< vertices whose faces form more than one fan
+  int degenerate_faces = 0;               ///< repeated corners or (near) zero area
   int inconsistently_oriented_edges = 0;  ///< interior edges used twice in the same direction
 
   bool is_manifold() const { return non_manifold_edges == 0 && non_manifold_vertices == 0; }

@@ -22,9 +22,7 @@ struct Volume {
   std::size_t num_voxels() const { return size[0] * size[1] * size[2]; }
   /// The largest voxel side, in mm.
   double max_spacing() const { return std::max({spacing[0], spacing[1], spacing[2]}); }
-  std::size_t index(std::size_t i, std::size_t j, std::size_t k) const {
-    return i + size[0] * (j + size[1] * k);
-  }
+  std::size_t index(std::size_t i, std::size_t j, std::size_t k) const { return i + size[0] * (j + size[1] * k); }
   float& at(std::size_t i, std::size_t j, std::size_t k) { return data[index(i, j, k)]; }
   float at(std::size_t i, std::size_t j, std::size_t k) const { return data[index(i, j, k)]; }
 

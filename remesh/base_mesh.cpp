@@ -43,7 +43,8 @@ void triangulate_samples(const Parameterization& param, const std::vector<bool>&
     RowMatrixX3d lifted(m, 3);
     for (int i = 0; i < m; ++i) {
       if (boundary[base.samples[i]]) base.domain.row(i) = project_to_domain(DomainKind::disk, base.domain.row(i), true);
-      lifted.row(i) << base.domain(i, 0), base.domain(i, 1), base.domain(i, 0) * base.domain(i, 0) + base.domain(i, 1) * base.domain(i, 1);
+      lifted.row(i) << base.domain(i, 0), base.domain(i, 1),
+          base.domain(i, 0) * base.domain(i, 0) + base.domain(i, 1) * base.domain(i, 1);
     }
     const RowMatrixX3i hull = convex_hull_faces(lifted);
     std::vector<Eigen::RowVector3i> lower;
@@ -72,7 +73,8 @@ void triangulate_samples(const Parameterization& param, const std::vector<bool>&
 // convex in D (so neither new face flips), updating the valences. \return whether it flipped.
 bool flip_if_convex_in_domain(const RowMatrixX3d& D, RowMatrixX3i& F, int f1, int f2, int a, int b, int c, int d,
                               std::vector<int>& valence) {
-  if (!(domain_orientation(D.row(a), D.row(d), D.row(c)) > 0) || !(domain_orientation(D.row(d), D.row(b), D.row(c)) > 0))
+  if (!(domain_orientation(D.row(a), D.row(d), D.row(c)) > 0) ||
+      !(domain_orientation(D.row(d), D.row(b), D.row(c)) > 0))
     return false;
   F.row(f1) << a, d, c;
   F.row(f2) << d, b, c;
@@ -106,7 +108,8 @@ int flip_toward_surface_delaunay(const RowMatrixX3d& D, const RowMatrixX3d& X, R
       const int f1 = fc.first, f2 = twin->second.first;
       if (touched[f1] || touched[f2]) continue;
       const int c = F(f1, fc.second), d = F(f2, twin->second.second);
-      if (c == d || edge_faces.count({c, d}) || edge_faces.count({d, c}) || valence[a] <= 3 || valence[b] <= 3) continue;
+      if (c == d || edge_faces.count({c, d}) || edge_faces.count({d, c}) || valence[a] <= 3 || valence[b] <= 3)
+        continue;
       // The surface's Delaunay condition: the two angles facing the edge sum to at most pi.
       if (!(angle_at(c, a, b) + angle_at(d, b, a) > 3.14159265358979323846 + 1e-9)) continue;
       if (!flip_if_convex_in_domain(D, F, f1, f2, a, b, c, d, valence)) continue;
@@ -147,7 +150,8 @@ int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F, int rim_
       const int f1 = fc.first, f2 = twin->second.first;
       if (touched[f1] || touched[f2]) continue;
       const int c = F(f1, fc.second), d = F(f2, twin->second.second);
-      if (c == d || edge_faces.count({c, d}) || edge_faces.count({d, c}) || created.count({std::min(c, d), std::max(c, d)}))
+      if (c == d || edge_faces.count({c, d}) || edge_faces.count({d, c}) ||
+          created.count({std::min(c, d), std::max(c, d)}))
         continue;
       // Never below 3 edges inside, or rim_min_triangles + 1 on the rim: a rim vertex with 2
       // triangles splits a ~180-240 degree rim angle into two obtuse corners at every level.

@@ -12,12 +12,12 @@
 namespace mrsnake {
 
 struct BaseMesh {
-  RowMatrixX3i faces;          ///< F0, counter-clockwise in D
-  RowMatrixX3d domain;         ///< n0 rows: base vertex positions in D
-  std::vector<int> samples;    ///< the vertex of the parameterized surface under each base vertex
-  int surface_flips = 0;       ///< edge flips made toward the surface's Delaunay triangulation
-  int valence_flips = 0;       ///< edge flips made to even out valences
-  int dropped_rim_samples = 0; ///< disk rim samples dropped: fewer than rim_min_triangles triangles
+  RowMatrixX3i faces;           ///< F0, counter-clockwise in D
+  RowMatrixX3d domain;          ///< n0 rows: base vertex positions in D
+  std::vector<int> samples;     ///< the vertex of the parameterized surface under each base vertex
+  int surface_flips = 0;        ///< edge flips made toward the surface's Delaunay triangulation
+  int valence_flips = 0;        ///< edge flips made to even out valences
+  int dropped_rim_samples = 0;  ///< disk rim samples dropped: fewer than rim_min_triangles triangles
 };
 
 /// With a disk, rim samples left with fewer than rim_min_triangles triangles are dropped and

@@ -37,7 +37,7 @@ using NaturalLU = Eigen::SparseLU<EigenMatrix, Eigen::NaturalOrdering<int>>;
 struct CachedLUTraits : BaseTraits {
   const Matrix* factored = nullptr;
   Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P;  // permuted = P A Pᵀ
-  std::shared_ptr<NaturalLU> lu = std::make_shared<NaturalLU>();     // traits are copied by CGAL
+  std::shared_ptr<NaturalLU> lu = std::make_shared<NaturalLU>();    // traits are copied by CGAL
   bool linear_solver(const Matrix& A, const Vector& B, Vector& X, NT& D) {
     if (factored != &A) {
       const EigenMatrix& M = A.eigen_object();
@@ -74,7 +74,8 @@ Eigen::MatrixX2d mean_value_disk_map(const TriMesh& disk) {
 
   SurfaceMesh sm;
   std::vector<VertexIndex> vertex(disk.num_vertices());
-  for (int v = 0; v < disk.num_vertices(); ++v) vertex[v] = sm.add_vertex(Point_3(disk.V(v, 0), disk.V(v, 1), disk.V(v, 2)));
+  for (int v = 0; v < disk.num_vertices(); ++v)
+    vertex[v] = sm.add_vertex(Point_3(disk.V(v, 0), disk.V(v, 1), disk.V(v, 2)));
   for (int f = 0; f < disk.num_faces(); ++f) {
     const auto face = sm.add_face(vertex[disk.F(f, 0)], vertex[disk.F(f, 1)], vertex[disk.F(f, 2)]);
     if (face == SurfaceMesh::null_face())
@@ -82,8 +83,7 @@ Eigen::MatrixX2d mean_value_disk_map(const TriMesh& disk) {
                            " is non-manifold); repair the mesh first");
   }
   const auto border = CGAL::Polygon_mesh_processing::longest_border(sm).first;
-  if (border == SurfaceMesh::null_halfedge())
-    throw AlgorithmError("the surface to parameterize has no boundary");
+  if (border == SurfaceMesh::null_halfedge()) throw AlgorithmError("the surface to parameterize has no boundary");
   auto uv = sm.add_property_map<VertexIndex, Point_2>("v:uv").first;
   const SMP::Error_code err = SMP::parameterize(sm, Parameterizer(), border, uv);
   if (err != SMP::OK)
@@ -95,8 +95,9 @@ Eigen::MatrixX2d mean_value_disk_map(const TriMesh& disk) {
     out(v, 0) = p.x();
     out(v, 1) = p.y();
     if (!std::isfinite(out(v, 0)) || !std::isfinite(out(v, 1)))
-      throw AlgorithmError("the parameterization produced non-finite coordinates; the surface may have degenerate "
-                           "triangles: repair or smooth it first");
+      throw AlgorithmError(
+          "the parameterization produced non-finite coordinates; the surface may have degenerate "
+          "triangles: repair or smooth it first");
   }
   return out;
 }

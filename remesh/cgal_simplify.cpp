@@ -35,7 +35,8 @@ namespace SMS = CGAL::Surface_mesh_simplification;
 SurfaceMesh to_surface_mesh(const TriMesh& mesh) {
   SurfaceMesh sm;
   std::vector<VertexIndex> vertex(mesh.num_vertices());
-  for (int v = 0; v < mesh.num_vertices(); ++v) vertex[v] = sm.add_vertex(Point_3(mesh.V(v, 0), mesh.V(v, 1), mesh.V(v, 2)));
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    vertex[v] = sm.add_vertex(Point_3(mesh.V(v, 0), mesh.V(v, 1), mesh.V(v, 2)));
   for (int f = 0; f < mesh.num_faces(); ++f)
     if (sm.add_face(vertex[mesh.F(f, 0)], vertex[mesh.F(f, 1)], vertex[mesh.F(f, 2)]) == SurfaceMesh::null_face())
       throw AlgorithmError("the surface could not be built for simplification (face " + std::to_string(f) +
@@ -49,10 +50,12 @@ SurfaceMesh to_surface_mesh(const TriMesh& mesh) {
 // computes (2.52 -> 1.95 s on the liver staircase, 442k -> 128k faces, the same collapses).
 // Edges marked in `frozen` are never collapsed, and the point where a vertex on one of them
 // stands never moves (its index may: CGAL keeps either end of a collapsed edge).
-void collapse_shortest_edges(SurfaceMesh& sm, std::size_t max_edges, const SurfaceMesh::Property_map<EdgeIndex, bool>& frozen) {
+void collapse_shortest_edges(SurfaceMesh& sm, std::size_t max_edges,
+                             const SurfaceMesh::Property_map<EdgeIndex, bool>& frozen) {
   SMS::Count_stop_predicate<SurfaceMesh> stop(max_edges);
   SMS::Bounded_normal_change_filter<> normal_change;
-  using Placement = SMS::Constrained_placement<SMS::Midpoint_placement<SurfaceMesh>, SurfaceMesh::Property_map<EdgeIndex, bool>>;
+  using Placement =
+      SMS::Constrained_placement<SMS::Midpoint_placement<SurfaceMesh>, SurfaceMesh::Property_map<EdgeIndex, bool>>;
   SMS::edge_collapse(sm, stop,
                      CGAL::parameters::get_cost(SMS::Edge_length_cost<SurfaceMesh>())
                          .get_placement(Placement(frozen))
@@ -80,7 +83,8 @@ SurfaceMesh simplify_halves(const TriMesh& mesh, int target_faces) {
   int axis = 0;
   extent.maxCoeff(&axis);
   std::vector<double> height(m);
-  for (int f = 0; f < m; ++f) height[f] = mesh.V(mesh.F(f, 0), axis) + mesh.V(mesh.F(f, 1), axis) + mesh.V(mesh.F(f, 2), axis);
+  for (int f = 0; f < m; ++f)
+    height[f] = mesh.V(mesh.F(f, 0), axis) + mesh.V(mesh.F(f, 1), axis) + mesh.V(mesh.F(f, 2), axis);
   // Ties (a staircase's heights are few) broken by face index, so that the halves are equal.
   std::vector<int> order(m);
   std::iota(order.begin(), order.end(), 0);

@@ -60,7 +60,8 @@ int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh&
   std::vector<int> far;
   for (int s = 0; s < input_vertices; ++s)
     if (distance[s] > far_threshold && face_of[s] >= 0 && !input_rim[s]) far.push_back(s);
-  std::sort(far.begin(), far.end(), [&](int a, int b) { return distance[a] > distance[b] || (distance[a] == distance[b] && a < b); });
+  std::sort(far.begin(), far.end(),
+            [&](int a, int b) { return distance[a] > distance[b] || (distance[a] == distance[b] && a < b); });
 
   // The faces of v's star and of its neighbours' stars: the triangles a move of v can change
   // the nearest point on, for the input near v.
@@ -170,7 +171,8 @@ int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh&
     for (int s = 0; s < input_vertices; ++s)
       if (changed[nearest_face[s]] || distance[s] > limit) recheck.push_back(s);
     RowMatrixX3d points(static_cast<Eigen::Index>(recheck.size()), 3);
-    for (std::size_t i = 0; i < recheck.size(); ++i) points.row(static_cast<Eigen::Index>(i)) = surface_V.row(recheck[i]);
+    for (std::size_t i = 0; i < recheck.size(); ++i)
+      points.row(static_cast<Eigen::Index>(i)) = surface_V.row(recheck[i]);
     const double largest_after = recheck.empty() ? 0.0 : SurfaceLocator(TriMesh{X, F}).distances(points).maxCoeff();
     if (!(largest_after <= limit)) {
       U = U_before;

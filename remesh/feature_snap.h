@@ -19,10 +19,10 @@
 namespace mrsnake {
 
 struct FeatureSnapOptions {
-  int max_snaps = 32;            ///< at most this many vertices move
-  double min_distance = 0.1;     ///< only input vertices farther than this x the mean edge length
-  double min_quality = 0.65;     ///< the moved vertex's triangles keep Q >= this
-  double min_angle_deg = 32;     ///< and angles >= this (the repair after it keeps snapped tips fixed)
+  int max_snaps = 32;         ///< at most this many vertices move
+  double min_distance = 0.1;  ///< only input vertices farther than this x the mean edge length
+  double min_quality = 0.65;  ///< the moved vertex's triangles keep Q >= this
+  double min_angle_deg = 32;  ///< and angles >= this (the repair after it keeps snapped tips fixed)
   /// A snap of v must lower the largest distance from the input vertices near v (those whose
   /// nearest level face is around v or its neighbours) to the level by at least this fraction,
   /// and all snaps together the largest distance from the whole input.

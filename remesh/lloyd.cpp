@@ -56,10 +56,12 @@ LloydStats constrained_lloyd(DomainKind kind, const RowMatrixX3i& F, const Densi
   const int n = static_cast<int>(U.rows());
   const int m = static_cast<int>(F.rows());
   const VertexStars star(F, n);
-  const std::vector<bool> boundary = kind == DomainKind::disk ? boundary_vertices(F, star) : std::vector<bool>(n, false);
+  const std::vector<bool> boundary =
+      kind == DomainKind::disk ? boundary_vertices(F, star) : std::vector<bool>(n, false);
   std::vector<int> face_hint(m);
   for (int f = 0; f < m; ++f) face_hint[f] = vertex_hints[F(f, 0)];
-  const int r = std::min(48, static_cast<int>(std::floor(std::sqrt(static_cast<double>(options.sample_budget) / std::max(1, m)))));
+  const int r = std::min(
+      48, static_cast<int>(std::floor(std::sqrt(static_cast<double>(options.sample_budget) / std::max(1, m)))));
 
   Eigen::VectorXd mass(n);
   RowMatrixX3d moment(n, 3);
@@ -70,44 +72,48 @@ LloydStats constrained_lloyd(DomainKind kind, const RowMatrixX3i& F, const Densi
     moment.setZero();
     // The density integrals of the faces are independent (each face walks from its own
     // hint): computed in parallel, then summed in face order as before.
-    parallel_ranges(static_cast<std::size_t>(m), [&](std::size_t begin, std::size_t end) {
-      for (int f = static_cast<int>(begin); f < static_cast<int>(end); ++f) {
-        const Eigen::Vector3d P[3] = {U.row(F(f, 0)), U.row(F(f, 1)), U.row(F(f, 2))};
-        const double third = 0.5 * (P[1] - P[0]).cross(P[2] - P[0]).norm() / 3.0;
-        Eigen::Vector3d centroid[3];
-        double rho[3];
-        for (int k = 0; k < 3; ++k) centroid[k] = quad_centroid(P[k], P[(k + 1) % 3], P[(k + 2) % 3]);
-        if (r <= 2) {
-          for (int k = 0; k < 3; ++k) rho[k] = density.at(centroid[k], face_hint[f]);
-        } else {
-          // Mean density over the grid samples falling in each corner's quadrilateral (the
-          // region where that corner's barycentric coordinate is the largest).
-          double sum[3] = {0, 0, 0}, count[3] = {0, 0, 0};
-          auto sample = [&](double x, double y) {
-            const Eigen::Vector3d l(1 - x - y, x, y);
-            const double value = density.at(l[0] * P[0] + l[1] * P[1] + l[2] * P[2], face_hint[f]);
-            const double top = l.maxCoeff();
-            int ties = 0;
-            for (int k = 0; k < 3; ++k) ties += l[k] >= top - 1e-12;
-            for (int k = 0; k < 3; ++k)
-              if (l[k] >= top - 1e-12) {
-                sum[k] += value / ties;
-                count[k] += 1.0 / ties;
-              }
-          };
-          for (int i = 0; i < r; ++i)
-            for (int j = 0; i + j < r; ++j) {
-              sample((i + 1.0 / 3) / r, (j + 1.0 / 3) / r);
-              if (i + j <= r - 2) sample((i + 2.0 / 3) / r, (j + 2.0 / 3) / r);
+    parallel_ranges(
+        static_cast<std::size_t>(m),
+        [&](std::size_t begin, std::size_t end) {
+          for (int f = static_cast<int>(begin); f < static_cast<int>(end); ++f) {
+            const Eigen::Vector3d P[3] = {U.row(F(f, 0)), U.row(F(f, 1)), U.row(F(f, 2))};
+            const double third = 0.5 * (P[1] - P[0]).cross(P[2] - P[0]).norm() / 3.0;
+            Eigen::Vector3d centroid[3];
+            double rho[3];
+            for (int k = 0; k < 3; ++k) centroid[k] = quad_centroid(P[k], P[(k + 1) % 3], P[(k + 2) % 3]);
+            if (r <= 2) {
+              for (int k = 0; k < 3; ++k) rho[k] = density.at(centroid[k], face_hint[f]);
+            } else {
+              // Mean density over the grid samples falling in each corner's quadrilateral (the
+              // region where that corner's barycentric coordinate is the largest).
+              double sum[3] = {0, 0, 0}, count[3] = {0, 0, 0};
+              auto sample = [&](double x, double y) {
+                const Eigen::Vector3d l(1 - x - y, x, y);
+                const double value = density.at(l[0] * P[0] + l[1] * P[1] + l[2] * P[2], face_hint[f]);
+                const double top = l.maxCoeff();
+                int ties = 0;
+                for (int k = 0; k < 3; ++k) ties += l[k] >= top - 1e-12;
+                for (int k = 0; k < 3; ++k)
+                  if (l[k] >= top - 1e-12) {
+                    sum[k] += value / ties;
+                    count[k] += 1.0 / ties;
+                  }
+              };
+              for (int i = 0; i < r; ++i)
+                for (int j = 0; i + j < r; ++j) {
+                  sample((i + 1.0 / 3) / r, (j + 1.0 / 3) / r);
+                  if (i + j <= r - 2) sample((i + 2.0 / 3) / r, (j + 2.0 / 3) / r);
+                }
+              for (int k = 0; k < 3; ++k)
+                rho[k] = count[k] > 0 ? sum[k] / count[k] : density.at(centroid[k], face_hint[f]);
             }
-          for (int k = 0; k < 3; ++k) rho[k] = count[k] > 0 ? sum[k] / count[k] : density.at(centroid[k], face_hint[f]);
-        }
-        for (int k = 0; k < 3; ++k) {
-          weight[f][k] = rho[k] * third;
-          corner_centroid[f][k] = centroid[k];
-        }
-      }
-    }, /*min_per_thread=*/16);
+            for (int k = 0; k < 3; ++k) {
+              weight[f][k] = rho[k] * third;
+              corner_centroid[f][k] = centroid[k];
+            }
+          }
+        },
+        /*min_per_thread=*/16);
     for (int f = 0; f < m; ++f)
       for (int k = 0; k < 3; ++k) {
         const double w = weight[f][k];

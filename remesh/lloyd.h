@@ -23,8 +23,8 @@ struct DensityField {
 
 struct LloydOptions {
   int iterations = 8;
-  int first_movable = 0;        ///< vertices [0, first_movable) stay fixed (the paper's strict mode)
-  double step = 1.0;            ///< fraction of the way to the centroid moved per iteration
+  int first_movable = 0;  ///< vertices [0, first_movable) stay fixed (the paper's strict mode)
+  double step = 1.0;      ///< fraction of the way to the centroid moved per iteration
   /// Density samples per iteration over all faces: a face gets about budget / faces of them
   /// (at least the 3 corner-quadrilateral centroids, from about 2.8k faces up). Coarse levels
   /// integrate finely. At the fine levels the 3 samples per face were measured to be enough
@@ -35,10 +35,10 @@ struct LloydOptions {
 };
 
 struct LloydStats {
-  int moves = 0;           ///< vertex moves made
-  int shortened_moves = 0; ///< moves shortened because the full move would flip a triangle
-  int rejected_moves = 0;  ///< moves dropped for the same reason
-  double mean_shift = 0;   ///< mean move of the last iteration (in D)
+  int moves = 0;            ///< vertex moves made
+  int shortened_moves = 0;  ///< moves shortened because the full move would flip a triangle
+  int rejected_moves = 0;   ///< moves dropped for the same reason
+  double mean_shift = 0;    ///< mean move of the last iteration (in D)
 };
 
 /// Relaxes the positions U (in D) of the triangulation F by constrained Lloyd iterations.

@@ -527,7 +527,8 @@ Parameterization parameterize(const TriMesh& input, const ParameterizationOption
     param.kind = DomainKind::disk;
     const auto solve_start = std::chrono::steady_clock::now();
     const Eigen::MatrixX2d uv = mean_value_disk_map(mesh);
-    param.summary["solver_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
+    param.summary["solver_seconds"] =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
     for (int v = 0; v < n; ++v) param.domain.row(v) << 2 * uv(v, 0) - 1, 2 * uv(v, 1) - 1, 1.0;
     double signed_area = 0;
     for (int f = 0; f < mesh.num_faces(); ++f)
@@ -584,11 +585,12 @@ Parameterization parameterize(const TriMesh& input, const ParameterizationOption
       orient_and_balance();
     }
     if (options.sphere_map == SphereMap::automatic) fall_back_to_hierarchical_map(mesh, param);
-    param.summary["sphere_map"] = param.sphere_map == SphereMap::two_halves   ? "two_halves"
+    param.summary["sphere_map"] = param.sphere_map == SphereMap::two_halves     ? "two_halves"
                                   : param.sphere_map == SphereMap::hierarchical ? "hierarchical"
                                                                                 : "punctured";
     // The sphere map's whole time: the cut search or the puncture, and the solve(s).
-    param.summary["solver_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
+    param.summary["solver_seconds"] =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
   }
 
   const int flipped = count_flipped(param.domain, mesh.F);
@@ -619,13 +621,14 @@ Parameterization parameterize(const TriMesh& input, const ParameterizationOption
   std::vector<double> sorted(param.face_stretch.data(), param.face_stretch.data() + m);
   std::sort(sorted.begin(), sorted.end());
   if (!std::isfinite(param.vertex_stretch.sum()) || !(sorted.front() > 0) || !std::isfinite(sorted.back()))
-    throw AlgorithmError("the parameterization is degenerate (zero-area triangles in the domain); the surface cannot "
-                         "be parameterized well: repair degenerate triangles first");
+    throw AlgorithmError(
+        "the parameterization is degenerate (zero-area triangles in the domain); the surface cannot "
+        "be parameterized well: repair degenerate triangles first");
   const double spread_log10 = spread_of_sorted_log10(sorted);
   if (spread_log10 > max_stretch_spread_log10)
-    throw AlgorithmError("the parameterization is too distorted (area stretch spans " +
-                         std::to_string(static_cast<int>(spread_log10)) +
-                         " orders of magnitude): long protrusions cannot be remeshed from one chart; simplify the shape");
+    throw AlgorithmError(
+        "the parameterization is too distorted (area stretch spans " + std::to_string(static_cast<int>(spread_log10)) +
+        " orders of magnitude): long protrusions cannot be remeshed from one chart; simplify the shape");
 
   param.summary["method"] =
       param.kind == DomainKind::disk ? "mean value coordinates on the unit disk, Mobius balanced"

@@ -57,12 +57,12 @@ struct ParameterizationOptions {
 struct Parameterization {
   DomainKind kind = DomainKind::sphere;
   SphereMap sphere_map = SphereMap::punctured;  ///< the map used (punctured or two_halves), when kind is sphere
-  TriMesh surface;                 ///< the input, unreferenced vertices dropped
-  RowMatrixX3d domain;             ///< position in D of each vertex of `surface`
-  Eigen::VectorXd face_stretch;    ///< per face: A3D / A_D (the inverse of the paper's distortion d)
-  Eigen::VectorXd vertex_stretch;  ///< per vertex: sum of incident A3D / sum of incident A_D
-  std::vector<int> cut;            ///< with two_halves: the surface vertices on the cut, by index (they lie on one circle of D)
-  nlohmann::json summary;          ///< method, distortion range, seconds
+  TriMesh surface;                              ///< the input, unreferenced vertices dropped
+  RowMatrixX3d domain;                          ///< position in D of each vertex of `surface`
+  Eigen::VectorXd face_stretch;                 ///< per face: A3D / A_D (the inverse of the paper's distortion d)
+  Eigen::VectorXd vertex_stretch;               ///< per vertex: sum of incident A3D / sum of incident A_D
+  std::vector<int> cut;    ///< with two_halves: the surface vertices on the cut, by index (they lie on one circle of D)
+  nlohmann::json summary;  ///< method, distortion range, seconds
 };
 
 /// \pre input is a disk or a closed genus-0 surface.

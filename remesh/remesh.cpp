@@ -90,7 +90,8 @@ SizingFields sizing_fields(const TriMesh& surface, const RemeshOptions& options,
   // Averaged over about a base spacing (sqrt(n / n0) edge rings): the base follows where the
   // surface bends at its own scale, not voxel steps.
   if (options.base_density_exponent > 0) {
-    const int passes = options.base_density_smoothing < 0 ? base_spacing_rings(surface, n0) : options.base_density_smoothing;
+    const int passes =
+        options.base_density_smoothing < 0 ? base_spacing_rings(surface, n0) : options.base_density_smoothing;
     s.base_density = smooth_vertex_field(surface, s.wanted, passes).array().pow(options.base_density_exponent).matrix();
   }
   const double max_bend = options.max_base_bend;
@@ -221,8 +222,8 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     const RowMatrixX3i& F = result.connectivity.faces[j];
     if (j > 0) {
       U = midpoint_refine(result.connectivity, j - 1, U);
-      const std::vector<bool> boundary =
-          kind == DomainKind::disk ? boundary_vertices(F, static_cast<int>(U.rows())) : std::vector<bool>(U.rows(), false);
+      const std::vector<bool> boundary = kind == DomainKind::disk ? boundary_vertices(F, static_cast<int>(U.rows()))
+                                                                  : std::vector<bool>(U.rows(), false);
       const int previous = result.connectivity.vertex_count(j - 1);
       hints.resize(U.rows());
       for (int v = previous; v < U.rows(); ++v) {
@@ -252,11 +253,12 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
         shape_moves += smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, shape);
       }
     } else {
-      const bool relax = options.relax == RelaxMode::all_vertices ||
-                         (options.relax == RelaxMode::new_vertices_only && j > 0);
+      const bool relax =
+          options.relax == RelaxMode::all_vertices || (options.relax == RelaxMode::new_vertices_only && j > 0);
       if (relax) {
         lloyd.iterations = options.lloyd_iterations;
-        lloyd.first_movable = options.relax == RelaxMode::new_vertices_only ? result.connectivity.vertex_count(j - 1) : 0;
+        lloyd.first_movable =
+            options.relax == RelaxMode::new_vertices_only ? result.connectivity.vertex_count(j - 1) : 0;
         relax_stats = constrained_lloyd(kind, F, density, U, hints, lloyd);
       }
       level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
@@ -277,14 +279,16 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     if (options.relax == RelaxMode::all_vertices && options.snap_tips > 0 && j == levels) {
       FeatureSnapOptions snap;
       snap.max_snaps = options.snap_tips;
-      snapped = snap_to_input_tips(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, snap, &snapped_mask);
+      snapped =
+          snap_to_input_tips(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, snap, &snapped_mask);
     }
     // Onto the original input before the repair, so that the repair sees (and keeps) the
     // final triangles: the projection onto a marching-cubes staircase shears a few of them.
     const bool project_first = reproject && options.repair_after_reprojection;
     if (project_first) reproject_onto(*reproject, level.positions);
     TriangleRepairStats repair;
-    if (options.relax == RelaxMode::all_vertices && options.repair_sweeps > 0 && (options.repair_coarse_levels || j == levels)) {
+    if (options.relax == RelaxMode::all_vertices && options.repair_sweeps > 0 &&
+        (options.repair_coarse_levels || j == levels)) {
       TriangleRepairOptions repair_options;
       repair_options.sweeps = options.repair_sweeps;
       repair_options.threshold = options.repair_threshold;
@@ -331,9 +335,9 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     s["repair_moves"] = repair.moves;
     s["snapped_vertices"] = snapped;
     if (fit_rounds > 0 && j == levels)
-      s["fit"] = {{"rms_before_mm", fit.rms_before}, {"rms_after_mm", fit.rms_after}, {"mean_offset_mm", fit.mean_offset},
-                  {"max_offset_mm", fit.max_offset}, {"clamped_vertices", fit.clamped_vertices},
-                  {"held_vertices", fit.held_vertices}};
+      s["fit"] = {{"rms_before_mm", fit.rms_before},          {"rms_after_mm", fit.rms_after},
+                  {"mean_offset_mm", fit.mean_offset},        {"max_offset_mm", fit.max_offset},
+                  {"clamped_vertices", fit.clamped_vertices}, {"held_vertices", fit.held_vertices}};
     if (repair.moves > 0) {
       s["repair_q_min_before"] = repair.q_min_before;
       s["repair_q_min_after"] = repair.q_min_after;

@@ -26,8 +26,8 @@ std::vector<Eigen::Vector2i> rim_neighbours(const std::vector<std::pair<int, int
 }  // namespace
 
 int smooth_shapes_in_domain(DomainKind kind, const RowMatrixX3i& F, const DomainMesh& param,
-                            const RowMatrixX3d& surface_V, RowMatrixX3d& U, RowMatrixX3d& X,
-                            std::vector<int>& hints, const ShapeSmoothingOptions& options) {
+                            const RowMatrixX3d& surface_V, RowMatrixX3d& U, RowMatrixX3d& X, std::vector<int>& hints,
+                            const ShapeSmoothingOptions& options) {
   const int n = static_cast<int>(U.rows());
   const VertexStars stars(F, n);
   const std::vector<std::pair<int, int>> rim_edges =
@@ -95,7 +95,8 @@ int smooth_shapes_in_domain(DomainKind kind, const RowMatrixX3i& F, const Domain
       if (!pullback) continue;
       const Eigen::Vector3d domain_move = pullback->to_domain(move);
       const Eigen::Vector3d current = U.row(v);
-      const double floor = options.quality_floor > 0 ? std::min(star_quality(X, F, stars, v, x), options.quality_floor) : 0.0;
+      const double floor =
+          options.quality_floor > 0 ? std::min(star_quality(X, F, stars, v, x), options.quality_floor) : 0.0;
       double t = options.step;
       for (int attempt = 0; attempt < 8; ++attempt, t *= 0.5) {
         const Eigen::Vector3d candidate = project_to_domain(kind, current + t * domain_move, on_rim);

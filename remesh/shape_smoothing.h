@@ -48,7 +48,7 @@ struct ShapeSmoothingOptions {
 /// \post no triangle of (U, F) is flipped in D; disk rim vertices stay on the unit circle.
 /// \return the number of moves made.
 int smooth_shapes_in_domain(DomainKind kind, const RowMatrixX3i& F, const DomainMesh& param,
-                            const RowMatrixX3d& surface_V, RowMatrixX3d& U, RowMatrixX3d& X,
-                            std::vector<int>& hints, const ShapeSmoothingOptions& options);
+                            const RowMatrixX3d& surface_V, RowMatrixX3d& U, RowMatrixX3d& X, std::vector<int>& hints,
+                            const ShapeSmoothingOptions& options);
 
 }  // namespace mrsnake

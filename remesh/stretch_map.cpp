@@ -95,7 +95,8 @@ class StarRelaxer {
     // Probes well inside the star: a vertex of a sliver sits very close to its opposite edge.
     const double h = 1e-3 * height;
     const auto energy_at = [&](double x, double y) { return star_energy(v, frame.at(x, y)); };
-    const Eigen::Vector2d g((energy_at(h, 0) - energy_at(-h, 0)) / (2 * h), (energy_at(0, h) - energy_at(0, -h)) / (2 * h));
+    const Eigen::Vector2d g((energy_at(h, 0) - energy_at(-h, 0)) / (2 * h),
+                            (energy_at(0, h) - energy_at(0, -h)) / (2 * h));
     if (!std::isfinite(g.squaredNorm()) || g.squaredNorm() == 0) return false;
     const Eigen::Vector2d direction = -g.normalized();
     double step = 0.5 * radius;
@@ -169,12 +170,15 @@ class CollapsibleMesh {
  public:
   struct Collapse {
     int removed = -1, kept = -1;
-    std::vector<int> changed;   ///< faces that had `removed` and now have `kept` in its place
+    std::vector<int> changed;            ///< faces that had `removed` and now have `kept` in its place
     std::array<int, 2> deleted{-1, -1};  ///< the two faces of the collapsed edge
   };
 
   explicit CollapsibleMesh(const TriMesh& mesh)
-      : X(mesh.V), F(mesh.F), faces_of(faces_of_vertices(mesh.F, mesh.num_vertices())), alive_vertices_(mesh.num_vertices()) {}
+      : X(mesh.V),
+        F(mesh.F),
+        faces_of(faces_of_vertices(mesh.F, mesh.num_vertices())),
+        alive_vertices_(mesh.num_vertices()) {}
 
   std::vector<int> neighbors(int v) const {
     std::vector<int> ring;
@@ -290,8 +294,9 @@ std::vector<CollapsibleMesh::Collapse> collapse_to_tetrahedron(CollapsibleMesh& 
     }
     if (mesh.alive_vertices() <= 4) return history;
   }
-  throw AlgorithmError("the surface cannot be simplified to a tetrahedron by edge collapses; it is not a clean closed "
-                       "genus-0 manifold: repair it first");
+  throw AlgorithmError(
+      "the surface cannot be simplified to a tetrahedron by edge collapses; it is not a clean closed "
+      "genus-0 manifold: repair it first");
 }
 
 /// The four vertices left on a regular tetrahedron inscribed in the sphere, mirrored if needed
@@ -319,8 +324,10 @@ void place_split(const CollapsibleMesh::Collapse& c, const CollapsibleMesh& mesh
     for (int k = 0; k < 3; ++k)
       if (mesh.F(f, k) == u) {
         const int next = mesh.F(f, (k + 1) % 3), third = mesh.F(f, (k + 2) % 3);
-        if (next == v) left = third;
-        else right = next;
+        if (next == v)
+          left = third;
+        else
+          right = next;
       }
   const Vec3 pu = D.row(u);
   const Vec3 normal = pu.normalized();
@@ -341,8 +348,9 @@ void place_split(const CollapsibleMesh::Collapse& c, const CollapsibleMesh& mesh
       return;
     }
   }
-  throw AlgorithmError("a vertex split of the hierarchical sphere map found no place without a flipped triangle; "
-                       "the surface has degenerate triangles: repair them first");
+  throw AlgorithmError(
+      "a vertex split of the hierarchical sphere map found no place without a flipped triangle; "
+      "the surface has degenerate triangles: repair them first");
 }
 
 }  // namespace
@@ -351,7 +359,8 @@ double map_energy(const TriMesh& mesh, const RowMatrixX3d& domain, double area_w
   double e = 0;
   for (int f = 0; f < mesh.num_faces(); ++f) {
     const int a = mesh.F(f, 0), b = mesh.F(f, 1), c = mesh.F(f, 2);
-    e += face_energy(domain.row(a), domain.row(b), domain.row(c), mesh.V.row(a), mesh.V.row(b), mesh.V.row(c), area_weight);
+    e += face_energy(domain.row(a), domain.row(b), domain.row(c), mesh.V.row(a), mesh.V.row(b), mesh.V.row(c),
+                     area_weight);
   }
   return e;
 }

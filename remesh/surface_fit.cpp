@@ -112,7 +112,8 @@ SurfaceFitStats fit_to_surface(const RowMatrixX3i& F, RowMatrixX3d& X, const Sur
           if (hit.distance > options.max_sample_distance * length) weight(s) = 0;
           distance(s) = normal.dot(hit.point - p);
         }
-        for (int k = 0; k < 3; ++k) coefficient(s, k) = corner_weight(s, k) * normal.dot(normals.row(corner(s, k)).transpose());
+        for (int k = 0; k < 3; ++k)
+          coefficient(s, k) = corner_weight(s, k) * normal.dot(normals.row(corner(s, k)).transpose());
       }
     });
     // Normal equations of  sum_s w_s (a_s . t - (d_s + a_s . t_now))^2 + lambda sum_v mass_v t_v^2,
@@ -191,8 +192,7 @@ SurfaceFitStats fit_to_surface(const RowMatrixX3i& F, RowMatrixX3d& X, const Sur
     changed = false;
     face_normals(Y, F, face_normals_after);
     for (Eigen::Index f = 0; f < m; ++f) {
-      if (face_normals_after.row(f).dot(face_normals_before.row(f)) >= cos_limit &&
-          quality(Y, f) >= quality_floor(f))
+      if (face_normals_after.row(f).dot(face_normals_before.row(f)) >= cos_limit && quality(Y, f) >= quality_floor(f))
         continue;
       for (int k = 0; k < 3; ++k) {
         const int v = F(f, k);

@@ -20,8 +20,8 @@
 namespace mrsnake {
 
 /// The unit area-weighted normal of vertex v of (X, F), or nullopt where its faces cancel out.
-inline std::optional<Eigen::Vector3d> vertex_normal(const RowMatrixX3d& X, const RowMatrixX3i& F, const VertexStars& stars,
-                                                    int v) {
+inline std::optional<Eigen::Vector3d> vertex_normal(const RowMatrixX3d& X, const RowMatrixX3i& F,
+                                                    const VertexStars& stars, int v) {
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
     const int f = stars.faces[i];

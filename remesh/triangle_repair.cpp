@@ -19,7 +19,8 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
   const int n = static_cast<int>(U.rows());
   const int m = static_cast<int>(F.rows());
   const VertexStars stars(F, n);
-  const std::vector<bool> boundary = kind == DomainKind::disk ? boundary_vertices(F, stars) : std::vector<bool>(n, false);
+  const std::vector<bool> boundary =
+      kind == DomainKind::disk ? boundary_vertices(F, stars) : std::vector<bool>(n, false);
   const auto& PF = param.faces();
   const auto& PD = param.positions();
   auto quality = [&](int f, int v, const Eigen::Vector3d& x) {
@@ -141,7 +142,8 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
             const double q = star_quality(X, F, stars, v, lifted);
             if (!(q > best + 1e-9)) continue;
             if (options.guard_surface_error) {
-              if (allowed_error < 0) allowed_error = std::max(surface_error(v, u, x, x), options.error_tolerance * mean_edge);
+              if (allowed_error < 0)
+                allowed_error = std::max(surface_error(v, u, x, x), options.error_tolerance * mean_edge);
               if (surface_error(v, candidate, lifted, x) > allowed_error) continue;
             }
             best = q;

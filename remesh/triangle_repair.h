@@ -21,9 +21,9 @@
 namespace mrsnake {
 
 struct TriangleRepairOptions {
-  int sweeps = 6;            ///< passes over the poor triangles (each recomputes which are poor)
-  double threshold = 0.8;    ///< triangles with Q below this are repaired
-  bool move_rim = true;      ///< disk rim vertices may slide along the boundary
+  int sweeps = 6;          ///< passes over the poor triangles (each recomputes which are poor)
+  double threshold = 0.8;  ///< triangles with Q below this are repaired
+  bool move_rim = true;    ///< disk rim vertices may slide along the boundary
   /// Refuse moves that take the vertex's triangles further from the surface than before, or
   /// than error_tolerance x the mean edge length if that is more (largest distance between an
   /// edge's 3D midpoint and the lift of its midpoint in D, and from the vertex's old position
@@ -40,9 +40,9 @@ struct TriangleRepairOptions {
 };
 
 struct TriangleRepairStats {
-  int moves = 0;           ///< vertex moves made
-  double q_min_before = 0; ///< smallest Q in 3D before the repair
-  double q_min_after = 0;  ///< and after
+  int moves = 0;            ///< vertex moves made
+  double q_min_before = 0;  ///< smallest Q in 3D before the repair
+  double q_min_after = 0;   ///< and after
 };
 
 /// Repairs the worst triangles of (X, F) by moving vertices tangentially; updates U, X and hints.

@@ -146,9 +146,9 @@ Appearance build_appearance(const std::vector<Volume>& pyramid, const std::vecto
 
   ProfileAlignmentReport report;
   report.step_residual = profile_step_residual(a, faces);
-  const bool wanted = options.alignment == ProfileAlignment::edges ||
-                      (options.alignment == ProfileAlignment::automatic &&
-                       report.step_residual <= options.clean_edge_max_residual);
+  const bool wanted =
+      options.alignment == ProfileAlignment::edges ||
+      (options.alignment == ProfileAlignment::automatic && report.step_residual <= options.clean_edge_max_residual);
   report.to_edges = wanted && options.half_length >= 2;  // the crossing needs two samples a side
   if (report.to_edges) {
     // Only the levels sampled at full resolution: the label's rounding is below a coarser
@@ -196,12 +196,12 @@ ProfileAlignment parse_profile_alignment(const std::string& name) {
 }
 
 void to_json(nlohmann::json& j, const ProfileAlignmentReport& r) {
-  j = nlohmann::json{{"centred_on", r.to_edges ? "edges" : "labels"},
-                     {"step_residual",
-                      std::isfinite(r.step_residual) ? nlohmann::json(r.step_residual) : nlohmann::json()},
-                     {"levels_aligned", r.levels_aligned},
-                     {"mean_shift_mm", r.mean_shift_mm},
-                     {"mean_abs_shift_mm", r.mean_abs_shift_mm}};
+  j = nlohmann::json{
+      {"centred_on", r.to_edges ? "edges" : "labels"},
+      {"step_residual", std::isfinite(r.step_residual) ? nlohmann::json(r.step_residual) : nlohmann::json()},
+      {"levels_aligned", r.levels_aligned},
+      {"mean_shift_mm", r.mean_shift_mm},
+      {"mean_abs_shift_mm", r.mean_abs_shift_mm}};
 }
 
 namespace {
@@ -209,7 +209,8 @@ constexpr char kMagic[8] = {'M', 'R', 'S', 'A', 'P', 'P', '0', '2'};
 // Version 01 differs only in having no centre byte per level.
 constexpr char kMagicVersion01[8] = {'M', 'R', 'S', 'A', 'P', 'P', '0', '1'};
 
-constexpr const char* kTruncated = "the model's appearance section is truncated; rebuild the model with build-model --image";
+constexpr const char* kTruncated =
+    "the model's appearance section is truncated; rebuild the model with build-model --image";
 }  // namespace
 
 std::vector<std::uint8_t> serialize_appearance(const Appearance& a) {
@@ -250,7 +251,8 @@ Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes) {
   // The segmentation divides by the spreads and compares with the medians: a non-finite one
   // would silently derail it, so it is a defect of the model, not a value to use.
   for (double x : {a.region.inside, a.region.outside, a.inside_spread, a.outside_spread, a.shell_mm})
-    if (!std::isfinite(x)) throw InputError("the model's appearance section holds non-finite statistics; rebuild the model");
+    if (!std::isfinite(x))
+      throw InputError("the model's appearance section holds non-finite statistics; rebuild the model");
   for (int j = 0; j < levels; ++j) {
     LevelAppearance l;
     l.spacing_mm = r.get<double>();
@@ -272,7 +274,8 @@ Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes) {
       throw InputError("the model's appearance section holds non-finite profiles; rebuild the model");
     a.levels.push_back(std::move(l));
   }
-  if (r.position() != bytes.size()) throw InputError("the model's appearance section has trailing bytes; rebuild the model");
+  if (r.position() != bytes.size())
+    throw InputError("the model's appearance section has trailing bytes; rebuild the model");
   return a;
 }
 

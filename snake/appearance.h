@@ -18,7 +18,7 @@ namespace mrsnake {
 
 /// Where a level's learned profiles are centred along the normals.
 enum class ProfileCentre {
-  labels,      ///< on the label's surface
+  labels,  ///< on the label's surface
   /// On the image's edges (ProfileAlignment::edges): then they locate the object's boundary
   /// below the label's rounding, and the segmentation deforms the level even when it is finer
   /// than the image (segment.h).
@@ -31,17 +31,17 @@ std::string to_string(ProfileCentre centre);
 
 /// The profiles of one level of the hierarchy.
 struct LevelAppearance {
-  double spacing_mm = 1;      ///< distance between profile samples (the pyramid voxel size used)
-  Eigen::MatrixXf profiles;   ///< n_j × K, sample k at offset (k − K/2)·spacing_mm along the normal
+  double spacing_mm = 1;     ///< distance between profile samples (the pyramid voxel size used)
+  Eigen::MatrixXf profiles;  ///< n_j × K, sample k at offset (k − K/2)·spacing_mm along the normal
   ProfileCentre centre = ProfileCentre::labels;
 };
 
 struct Appearance {
-  int half_length = 5;             ///< K = 2·half_length + 1 samples per profile
+  int half_length = 5;  ///< K = 2·half_length + 1 samples per profile
   std::vector<LevelAppearance> levels;
-  RegionStats region;              ///< medians inside and in a shell outside (normalized units)
+  RegionStats region;                            ///< medians inside and in a shell outside (normalized units)
   double inside_spread = 0, outside_spread = 0;  ///< robust spreads (1.4826·MAD)
-  double shell_mm = 0;             ///< thickness of the shells the statistics come from
+  double shell_mm = 0;                           ///< thickness of the shells the statistics come from
 };
 
 /// Where each learned profile is centred along its normal.
@@ -75,10 +75,10 @@ struct AppearanceOptions {
 
 /// What build_appearance did about ProfileAlignment.
 struct ProfileAlignmentReport {
-  bool to_edges = false;  ///< the profiles were centred on the image's edges
+  bool to_edges = false;     ///< the profiles were centred on the image's edges
   double step_residual = 0;  ///< profile_step_residual of the profiles at the label's surface
   int levels_aligned = 0;    ///< levels whose profiles use the full-resolution image (only these move)
-  double mean_shift_mm = 0;      ///< over the vertices of the aligned levels, + outwards
+  double mean_shift_mm = 0;  ///< over the vertices of the aligned levels, + outwards
   double mean_abs_shift_mm = 0;
 };
 

@@ -101,7 +101,8 @@ InternalTerms compute_internal(const VertexRings& rings, const RowMatrixX3i& F, 
         const Eigen::Vector3d d = V.row(rings.neighbors[k]).transpose() - x;
         turn += std::complex<double>(d.dot(e1), d.dot(e2)) * std::conj(tangential.ring_directions[k]);
       }
-      const std::complex<double> target = (std::abs(turn) > 0 ? turn / std::abs(turn) : 1.0) * tangential.umbrella[v] * L[v];
+      const std::complex<double> target =
+          (std::abs(turn) > 0 ? turn / std::abs(turn) : 1.0) * tangential.umbrella[v] * L[v];
       tangential_force -= target.real() * e1 + target.imag() * e2;
     }
     t.force.row(v) = (o.membrane_weight * h + o.prior_weight * rel) * nv + o.tangential_weight * tangential_force;
@@ -110,7 +111,8 @@ InternalTerms compute_internal(const VertexRings& rings, const RowMatrixX3i& F, 
   if (o.thin_plate_weight > 0) {
     for (int v = 0; v < n; ++v) {
       Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-      for (int k = rings.offsets[v]; k < rings.offsets[v + 1]; ++k) mean += residual.row(rings.neighbors[k]).transpose();
+      for (int k = rings.offsets[v]; k < rings.offsets[v + 1]; ++k)
+        mean += residual.row(rings.neighbors[k]).transpose();
       const int val = rings.valence(v);
       if (val > 0) t.force.row(v) -= o.thin_plate_weight * (mean / val - residual.row(v).transpose()).transpose();
     }
@@ -127,7 +129,7 @@ RowMatrixX3d DeformableSurface::internal_forces(const RowMatrixX3d& V) const {
 }
 
 SnakeLevelReport DeformableSurface::run(RowMatrixX3d& V, const ExternalSearch& search, double search_step_mm,
-                                       double max_displacement_mm) const {
+                                        double max_displacement_mm) const {
   const SnakeOptions& o = options_;
   const int n = static_cast<int>(V.rows());
   SnakeLevelReport report;
@@ -150,7 +152,8 @@ SnakeLevelReport DeformableSurface::run(RowMatrixX3d& V, const ExternalSearch& s
     report.energy = report.external_energy + report.internal_energy;
     report.mean_abs_offset_mm = offsets.size() ? offsets.cwiseAbs().mean() : 0.0;
     report.iterations = it;
-    report.history.push_back({report.energy, report.external_energy, report.internal_energy, report.mean_abs_offset_mm});
+    report.history.push_back(
+        {report.energy, report.external_energy, report.internal_energy, report.mean_abs_offset_mm});
 
     // Convergence on the matched offsets and the energy, not on raw vertex motion.
     offset_history.push_back(report.mean_abs_offset_mm);

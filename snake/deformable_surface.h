@@ -21,7 +21,8 @@
 ///                 1-ring to resist noise
 /// Each step x ← x + τ·F is capped to max_step_fraction·ℓ_v and to |o_v| + that cap along
 /// the normal. Faces that would turn against their normal at the level's start, or by more
-/// than 60° in one step, reject the step of their vertices (halved, then dropped). The run stops when the matched offsets and the energy stop changing.
+/// than 60° in one step, reject the step of their vertices (halved, then dropped). The run stops when the matched
+/// offsets and the energy stop changing.
 #include <complex>
 #include <functional>
 #include <limits>
@@ -37,12 +38,13 @@ struct SnakeOptions {
   double membrane_weight = 0.0;     ///< α
   double thin_plate_weight = 0.05;  ///< β (τ·β must stay below ~0.4)
   double prior_weight = 0.35;       ///< w_p
-  double tangential_weight = 0.35;  ///< w_t, towards the model's tangential umbrella (τ·(α + w_p + w_t) must stay below ~1.2)
-  double external_weight = 0.35;    ///< w_e: fraction of the matched offset taken per step (segment.h)
-  double time_step = 1.0;           ///< τ
-  double max_step_fraction = 0.3;   ///< cap on a step, in local edge lengths
-  int offset_median = 1;            ///< ring-median passes over the matched offsets (before the averaging)
-  int offset_smoothing = 1;         ///< ring-averaging passes over the matched offsets
+  double tangential_weight =
+      0.35;  ///< w_t, towards the model's tangential umbrella (τ·(α + w_p + w_t) must stay below ~1.2)
+  double external_weight = 0.35;   ///< w_e: fraction of the matched offset taken per step (segment.h)
+  double time_step = 1.0;          ///< τ
+  double max_step_fraction = 0.3;  ///< cap on a step, in local edge lengths
+  int offset_median = 1;           ///< ring-median passes over the matched offsets (before the averaging)
+  int offset_smoothing = 1;        ///< ring-averaging passes over the matched offsets
   int max_iterations = 40;
   int min_iterations = 4;
   /// Convergence: the mean |matched offset| and the energy both change by less than this
@@ -59,12 +61,12 @@ using ExternalSearch = std::function<SearchResult(const RowMatrixX3d& V, const R
 struct SnakeLevelReport {
   int iterations = 0;
   bool converged = false;
-  double external_energy = 0;   ///< mean matched cost at the end
-  double internal_energy = 0;   ///< mean ½·(w_p·(h − ĥℓ)² + α·h² ) / ℓ² at the end (dimensionless)
-  double energy = 0;            ///< external + internal
-  double mean_abs_offset_mm = 0;///< mean |matched offset| at the end
-  int rejected_steps = 0;       ///< vertex steps halved or dropped to prevent a fold
-  int flipped_faces = 0;        ///< faces whose normal opposes the start's at the end
+  double external_energy = 0;     ///< mean matched cost at the end
+  double internal_energy = 0;     ///< mean ½·(w_p·(h − ĥℓ)² + α·h² ) / ℓ² at the end (dimensionless)
+  double energy = 0;              ///< external + internal
+  double mean_abs_offset_mm = 0;  ///< mean |matched offset| at the end
+  int rejected_steps = 0;         ///< vertex steps halved or dropped to prevent a fold
+  int flipped_faces = 0;          ///< faces whose normal opposes the start's at the end
   /// The figures above at every iteration, in order (the convergence plots of report.html).
   struct Iterate {
     double energy = 0, external_energy = 0, internal_energy = 0, mean_abs_offset_mm = 0;
@@ -90,8 +92,8 @@ TangentialPrior tangential_prior(const VertexRings& rings, const RowMatrixX3i& F
 
 /// What undo_self_intersections did.
 struct UndoOutcome {
-  int moved_vertices = 0;     ///< vertices moved back towards the safe positions
-  int remaining_pairs = 0;    ///< crossing face pairs left (mesh/distance.h)
+  int moved_vertices = 0;   ///< vertices moved back towards the safe positions
+  int remaining_pairs = 0;  ///< crossing face pairs left (mesh/distance.h)
 };
 
 /// Undoes self-intersections: the vertices of crossing faces (faces that share no vertex and

@@ -42,7 +42,8 @@ void require_same_grid(const Volume& a, const Volume& b, const std::string& a_na
 /// and infinite distances.
 /// \pre the volumes' buffers match their sizes.
 /// \throw InputError if the grids differ or the truth has no voxel with its label.
-SegmentationScores evaluate_segmentation(const Volume& seg, const Volume& truth, int seg_label = 1, int truth_label = 1);
+SegmentationScores evaluate_segmentation(const Volume& seg, const Volume& truth, int seg_label = 1,
+                                         int truth_label = 1);
 
 /// The q-quantile (0 < q <= 1) by nearest rank: the ⌈q·N⌉-th smallest value; 0 if empty.
 double nearest_rank_percentile(std::vector<double> values, double q);

@@ -59,7 +59,8 @@ SearchResult pick_offsets(const CostMatrix& cost, int nc, double h, const Normal
     if (valence > 0) {
       // A sharp match of its own (low cost) keeps the vertex on its own evidence.
       const double own_best = *std::min_element(curve.begin(), curve.end());
-      const double scale = options.ring_full_weight_cost > 0 ? std::min(1.0, own_best / options.ring_full_weight_cost) : 1.0;
+      const double scale =
+          options.ring_full_weight_cost > 0 ? std::min(1.0, own_best / options.ring_full_weight_cost) : 1.0;
       const double w = std::clamp(options.ring_weight * scale, 0.0, 1.0);
       if (w > 0) {
         for (double& c : curve) c *= 1.0 - w;
@@ -78,7 +79,7 @@ SearchResult pick_offsets(const CostMatrix& cost, int nc, double h, const Normal
 SearchResult search_step_edges(const VolumeSampler& image, const RowMatrixX3d& V, const RowMatrixX3d& N,
                                const RegionStats& stats, const NormalSearchOptions& options) {
   const double h = options.step_mm;
-  const int nc = std::max(0, static_cast<int>(std::floor(options.range_mm / h)));  // candidates −nc..nc
+  const int nc = std::max(0, static_cast<int>(std::floor(options.range_mm / h)));   // candidates −nc..nc
   const int w = std::max(1, static_cast<int>(std::lround(options.window_mm / h)));  // samples per side
   const int ns = 2 * (nc + w);  // samples at offsets (s − nc − w + 0.5)·h, s = 0..ns−1
   const double contrast2 = std::max(1e-12, (stats.inside - stats.outside) * (stats.inside - stats.outside));

@@ -18,9 +18,9 @@ namespace mrsnake {
 
 /// The 1D search along each normal.
 struct NormalSearchOptions {
-  double range_mm = 4.0;      ///< candidates at offsets in [−range, range]
-  double step_mm = 0.5;       ///< spacing of the candidates and of the samples
-  double window_mm = 3.0;     ///< step_edge: half-width of the step fitted around a candidate
+  double range_mm = 4.0;   ///< candidates at offsets in [−range, range]
+  double step_mm = 0.5;    ///< spacing of the candidates and of the samples
+  double window_mm = 3.0;  ///< step_edge: half-width of the step fitted around a candidate
   /// A mild preference for small moves: cost += distance_penalty·(t/range)² in units of the
   /// cost of a full mismatch, so that equally good candidates resolve towards the surface.
   /// segment() sets it per force (SegmentOptions::profile_distance_penalty, ::edge_distance_penalty).

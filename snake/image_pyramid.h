@@ -17,8 +17,8 @@ struct IntensityWindow {
 /// The low and high percentiles of the intensities, estimated on at most max_samples voxels
 /// taken on a regular stride (min and max if they coincide).
 /// \throw InputError if the image is empty or constant.
-IntensityWindow robust_intensity_window(const Volume& volume, double low_percentile = 1.0, double high_percentile = 99.0,
-                                        std::size_t max_samples = 1u << 20);
+IntensityWindow robust_intensity_window(const Volume& volume, double low_percentile = 1.0,
+                                        double high_percentile = 99.0, std::size_t max_samples = 1u << 20);
 
 /// Maps every voxel v to (v − window.low)/(window.high − window.low) in place (non-finite → 0).
 void apply_intensity_window(Volume& volume, const IntensityWindow& window);

@@ -31,9 +31,7 @@ Similarity Similarity::compose(const Similarity& o) const {
   return s;
 }
 
-double Similarity::rotation_angle_deg() const {
-  return Eigen::AngleAxisd(rotation).angle() * 180.0 / M_PI;
-}
+double Similarity::rotation_angle_deg() const { return Eigen::AngleAxisd(rotation).angle() * 180.0 / M_PI; }
 
 Moments mask_moments(const Volume& mask) {
   Moments m;
@@ -135,8 +133,9 @@ ThresholdClasses threshold_classes(const Volume& image, const Volume& smooth, co
   std::vector<float> upper, lower;
   double box_voxels = 1;
   for (int a = 0; a < 3; ++a) box_voxels *= static_cast<double>(std::max(0L, hi[a] - lo[a] + 1));
-  const long stride =
-      std::max(1L, static_cast<long>(std::ceil(std::cbrt(box_voxels / static_cast<double>(std::max<std::size_t>(1, max_samples))))));
+  const long stride = std::max(
+      1L,
+      static_cast<long>(std::ceil(std::cbrt(box_voxels / static_cast<double>(std::max<std::size_t>(1, max_samples))))));
   for (long k = lo[2]; k <= hi[2]; k += stride)
     for (long j = lo[1]; j <= hi[1]; j += stride)
       for (long i = lo[0]; i <= hi[0]; i += stride) {

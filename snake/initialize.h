@@ -61,8 +61,8 @@ ThresholdClasses threshold_classes(const Volume& image, const Volume& smooth, co
                                    const std::array<long, 3>& hi, std::size_t max_samples = 1u << 18);
 
 struct MomentsOptions {
-  double roi_margin = 0.3;  ///< the region of interest: the model's box grown by this fraction per side
-  bool rotate = true;       ///< also align principal axes (when they are well separated)
+  double roi_margin = 0.3;            ///< the region of interest: the model's box grown by this fraction per side
+  bool rotate = true;                 ///< also align principal axes (when they are well separated)
   double min_axis_separation = 0.15;  ///< relative eigenvalue gap below which axes are ambiguous
   double max_rotation_deg = 60;       ///< larger principal-axis rotations are rejected
   /// Threshold between object and background; NaN: Otsu's within the region of interest.
@@ -81,7 +81,7 @@ Similarity moments_alignment(const Volume& image, const TriMesh& model, const Mo
 
 struct TargetFitOptions {
   int iterations = 30;
-  bool with_scale = true;   ///< similarity (true) or rigid (false)
+  bool with_scale = true;  ///< similarity (true) or rigid (false)
   /// Stop when the mean vertex motion of an iteration is below this (mm). segment sets it
   /// from SegmentOptions::fit_tolerance_voxels and the image's voxels.
   double tolerance_mm = 0.01;

@@ -15,7 +15,7 @@ struct LabelFit {
   double dice = 0;
   double model_volume_mm3 = 0;  ///< of the rasterized level
   double label_volume_mm3 = 0;
-  double volume_ratio = 0;      ///< model / label
+  double volume_ratio = 0;  ///< model / label
 };
 
 /// Rasterizes `surface` (closed, in the labels' physical space) on the grid of `labels` and

@@ -45,14 +45,16 @@ Volume make_reference_crop(const Volume& image, const RowMatrixX3d& V, const Ref
     const double grow = options.margin_mm / image.spacing[a];
     const long last = static_cast<long>(image.size[a]) - 1;
     const double l = std::floor(mn[a] - grow), h = std::ceil(mx[a] + grow);
-    if (h < 0 || l > last) throw InputError("the model's surface lies outside the reference image; check that they match");
+    if (h < 0 || l > last)
+      throw InputError("the model's surface lies outside the reference image; check that they match");
     lo[a] = std::clamp(static_cast<long>(l), 0L, last);
     hi[a] = std::clamp(static_cast<long>(h), 0L, last);
     const long n = hi[a] - lo[a] + 1;
     factor[a] = std::max(1L, (n + options.max_voxels_per_axis - 1) / std::max(1, options.max_voxels_per_axis));
     out.size[a] = static_cast<std::size_t>(n / factor[a]);
     if (out.size[a] < 8)
-      throw InputError("the reference image around the model has fewer than 8 voxels along an axis; use a larger image");
+      throw InputError(
+          "the reference image around the model has fewer than 8 voxels along an axis; use a larger image");
     out.spacing[a] = image.spacing[a] * static_cast<double>(factor[a]);
   }
   out.direction = image.direction;
@@ -91,7 +93,8 @@ std::vector<std::uint8_t> serialize_reference_image(const Volume& r) {
 }
 
 Volume deserialize_reference_image(const std::vector<std::uint8_t>& bytes) {
-  if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) throw defect("is not in a format this build reads");
+  if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0)
+    throw defect("is not in a format this build reads");
   ByteReader r(bytes, 8, defect("is truncated").what());
   if (r.get<std::uint32_t>() != kVersion) throw defect("has a version this build does not read");
   Volume v;
@@ -108,7 +111,8 @@ Volume deserialize_reference_image(const std::vector<std::uint8_t>& bytes) {
   if (bytes.size() > expected) throw defect("has trailing bytes");
   std::uint64_t stored;
   stored = ByteReader(bytes, expected - 8, "").get<std::uint64_t>();
-  if (stored != fnv1a64(bytes.data(), expected - 8)) throw defect("was altered or corrupted (its checksum does not match)");
+  if (stored != fnv1a64(bytes.data(), expected - 8))
+    throw defect("was altered or corrupted (its checksum does not match)");
   for (int a = 0; a < 3; ++a)
     // Bounds far beyond any scanner's (µm to m voxels, km away) keep index arithmetic finite.
     if (!(v.spacing[a] >= 1e-3 && v.spacing[a] <= 1e3) || !(std::abs(v.origin[a]) <= 1e7))
@@ -118,7 +122,8 @@ Volume deserialize_reference_image(const std::vector<std::uint8_t>& bytes) {
     for (int b = 0; b < 3; ++b) {
       double dot = 0;
       for (int c = 0; c < 3; ++c) dot += v.direction[3 * c + a] * v.direction[3 * c + b];
-      if (!(std::abs(dot - (a == b ? 1.0 : 0.0)) < 1e-6)) throw defect("has a direction matrix that is not orthonormal");
+      if (!(std::abs(dot - (a == b ? 1.0 : 0.0)) < 1e-6))
+        throw defect("has a direction matrix that is not orthonormal");
     }
   v.data.resize(v.num_voxels());
   ByteReader voxels(bytes, kHeaderBytes, defect("is truncated").what());
@@ -131,12 +136,8 @@ Volume deserialize_reference_image(const std::vector<std::uint8_t>& bytes) {
 void reference_image_to_json(nlohmann::json& j, const Volume& r) {
   std::array<double, 3> extent{};
   for (int a = 0; a < 3; ++a) extent[a] = static_cast<double>(r.size[a]) * r.spacing[a];
-  j = nlohmann::json{{"size", r.size},
-                     {"spacing", r.spacing},
-                     {"origin", r.origin},
-                     {"direction", r.direction},
-                     {"extent_mm", extent},
-                     {"voxels", r.num_voxels()}};
+  j = nlohmann::json{{"size", r.size},           {"spacing", r.spacing}, {"origin", r.origin},
+                     {"direction", r.direction}, {"extent_mm", extent},  {"voxels", r.num_voxels()}};
 }
 
 }  // namespace mrsnake

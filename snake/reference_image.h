@@ -19,8 +19,8 @@ namespace mrsnake {
 constexpr const char* kReferenceImageSection = "reference_image";
 
 struct ReferenceImageOptions {
-  double margin_mm = 20;          ///< around the organ's bounding box, per side
-  int max_voxels_per_axis = 72;   ///< box-average by an integer factor per axis to stay within this
+  double margin_mm = 20;         ///< around the organ's bounding box, per side
+  int max_voxels_per_axis = 72;  ///< box-average by an integer factor per axis to stay within this
 };
 
 /// The crop of `image` around the points V (the model's finest level, in the image's

@@ -54,8 +54,7 @@ class TimeGuard : public itk::Command {
  public:
   using Self = TimeGuard;
   using Pointer = itk::SmartPointer<Self>;
-  itkNewMacro(Self)
-  Optimizer* optimizer = nullptr;
+  itkNewMacro(Self) Optimizer* optimizer = nullptr;
   Clock::time_point start;
   double max_seconds = 5.0;
   int iterations = 0;
@@ -65,7 +64,9 @@ class TimeGuard : public itk::Command {
   std::vector<double> level_values;  ///< the metric at each iteration of the current level
   int converged_levels = 0;          ///< levels stopped by the metric-change test
   bool level_converged = false;      ///< the current level was
-  void Execute(itk::Object* caller, const itk::EventObject& event) override { Execute(static_cast<const itk::Object*>(caller), event); }
+  void Execute(itk::Object* caller, const itk::EventObject& event) override {
+    Execute(static_cast<const itk::Object*>(caller), event);
+  }
   void Execute(const itk::Object*, const itk::EventObject& event) override {
     if (!itk::IterationEvent().CheckEvent(&event)) return;
     ++iterations;
@@ -122,8 +123,10 @@ ReducedImage bin_shrunk(FloatImage* input, int f, double sigma_fine) {
 int level_factor(int f, const FloatImage* a, const FloatImage* b) {
   itk::SizeValueType smallest = std::numeric_limits<itk::SizeValueType>::max();
   for (const FloatImage* image : {a, b})
-    for (unsigned axis = 0; axis < 3; ++axis) smallest = std::min(smallest, image->GetLargestPossibleRegion().GetSize()[axis]);
-  return static_cast<int>(std::clamp<itk::SizeValueType>(smallest / 4, 1, static_cast<itk::SizeValueType>(std::max(1, f))));
+    for (unsigned axis = 0; axis < 3; ++axis)
+      smallest = std::min(smallest, image->GetLargestPossibleRegion().GetSize()[axis]);
+  return static_cast<int>(
+      std::clamp<itk::SizeValueType>(smallest / 4, 1, static_cast<itk::SizeValueType>(std::max(1, f))));
 }
 
 // A regular grid of about `count` physical points of the fixed image (voxel centres).
@@ -258,7 +261,8 @@ Volume crop_volume(const Volume& image, const std::array<long, 3>& lo, const std
   for (int a = 0; a < 3; ++a) out.size[a] = static_cast<std::size_t>(hi[a] - lo[a] + 1);
   out.spacing = image.spacing;
   out.direction = image.direction;
-  out.origin = image.index_to_physical(static_cast<double>(lo[0]), static_cast<double>(lo[1]), static_cast<double>(lo[2]));
+  out.origin =
+      image.index_to_physical(static_cast<double>(lo[0]), static_cast<double>(lo[1]), static_cast<double>(lo[2]));
   out.data.resize(out.num_voxels());
   std::size_t n = 0;
   for (long k = lo[2]; k <= hi[2]; ++k)
@@ -277,13 +281,15 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
   if (fixed.data.size() != fixed.num_voxels() || moving.data.size() != moving.num_voxels())
     throw Error("internal: image buffer does not match its size");
   for (int a = 0; a < 3; ++a)
-    if (fixed.size[a] < 8) throw InputError("the reference image is too small to register (fewer than 8 voxels along an axis)");
+    if (fixed.size[a] < 8)
+      throw InputError("the reference image is too small to register (fewer than 8 voxels along an axis)");
   const std::size_t levels = o.shrink_factors.size();
   if (levels == 0 || o.smoothing_voxels.size() != levels)
     throw InputError("registration: give one smoothing value per shrink factor");
 
   // The centre of the fixed image: the rotation and the scale act about it.
-  const auto centre = fixed.index_to_physical(0.5 * (fixed.size[0] - 1.0), 0.5 * (fixed.size[1] - 1.0), 0.5 * (fixed.size[2] - 1.0));
+  const auto centre =
+      fixed.index_to_physical(0.5 * (fixed.size[0] - 1.0), 0.5 * (fixed.size[1] - 1.0), 0.5 * (fixed.size[2] - 1.0));
   // The part of the moving image the fixed image can reach from the start.
   std::vector<std::array<double, 3>> corners;
   for (int c = 0; c < 8; ++c) {
@@ -293,14 +299,15 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
     corners.push_back(q);
   }
   std::array<long, 3> lo{}, hi{};
-  if (!index_box_of_points(moving, corners, o.moving_margin_fraction, o.moving_margin_voxels * fixed.max_spacing(), lo, hi))
+  if (!index_box_of_points(moving, corners, o.moving_margin_fraction, o.moving_margin_voxels * fixed.max_spacing(), lo,
+                           hi))
     throw InputError("the model's reference image does not overlap the image; use another --init");
   for (int a = 0; a < 3; ++a)
-    if (hi[a] - lo[a] < 3) throw InputError("the model's reference image barely overlaps the image; use another --init");
+    if (hi[a] - lo[a] < 3)
+      throw InputError("the model's reference image barely overlaps the image; use another --init");
   Volume moving_crop = crop_volume(moving, lo, hi);
   if (o.moving_intensity_scale != 1.0 || o.moving_intensity_offset != 0.0)
-    for (float& v : moving_crop.data)
-      v = static_cast<float>(o.moving_intensity_scale * v + o.moving_intensity_offset);
+    for (float& v : moving_crop.data) v = static_cast<float>(o.moving_intensity_scale * v + o.moving_intensity_offset);
 
   RegistrationResult result;
   result.moving_crop_size = moving_crop.size;
@@ -327,7 +334,9 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
     // that it runs on one thread and repeats bit for bit.
     struct GlobalThreads {
       itk::ThreadIdType saved = itk::MultiThreaderBase::GetGlobalDefaultNumberOfThreads();
-      explicit GlobalThreads(int n) { itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(static_cast<itk::ThreadIdType>(n)); }
+      explicit GlobalThreads(int n) {
+        itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(static_cast<itk::ThreadIdType>(n));
+      }
       ~GlobalThreads() { itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(saved); }
     } threads(std::max(1, o.threads));
     const auto t_eval = Clock::now();

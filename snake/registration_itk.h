@@ -25,7 +25,7 @@ std::string to_string(RegistrationMetric metric);
 
 struct RegistrationOptions {
   RegistrationMetric metric = RegistrationMetric::mattes;
-  int histogram_bins = 32;                     ///< Mattes only
+  int histogram_bins = 32;  ///< Mattes only
   /// Coarse to fine: per level, both images are averaged over blocks of this many voxels per
   /// axis, then smoothed by a Gaussian of smoothing_voxels (in input voxels; 0 = none), and
   /// the transform found carries over to the next level.
@@ -47,9 +47,9 @@ struct RegistrationOptions {
   /// Radius at which rotations and scalings are measured against translations (parameter
   /// scales); <= 0: the RMS distance of the fixed image's edges from its centre.
   double rotation_radius_mm = 0;
-  double step_factor_per_level = 0.5;          ///< first step of level l: initial_step_voxels · factor^l
-  double min_step_voxels = 0.003;              ///< stop when the step falls below this (fixed image voxels)
-  double relaxation = 0.6;                     ///< step factor when the gradient turns back
+  double step_factor_per_level = 0.5;  ///< first step of level l: initial_step_voxels · factor^l
+  double min_step_voxels = 0.003;      ///< stop when the step falls below this (fixed image voxels)
+  double relaxation = 0.6;             ///< step factor when the gradient turns back
   /// Stop a level early once the metric (on that level's samples) has changed by less than
   /// this fraction of its magnitude over the last `convergence_window` iterations (0: off):
   /// the optimizer then creeps along a flat minimum, which costs time and moves nothing.
@@ -69,7 +69,7 @@ struct RegistrationOptions {
   /// 0.1-0.3 s, so that under any normal load the iteration counts stop it first and the
   /// result does not depend on timing; a run it stops says "time budget spent" in stop_condition.
   double max_seconds = 5.0;
-  int threads = 1;                             ///< ITK work units (1: one thread)
+  int threads = 1;  ///< ITK work units (1: one thread)
 };
 
 /// x ↦ matrix·x + offset, with matrix = scale·R (R a rotation), in physical space; also in
@@ -81,27 +81,27 @@ struct RegistrationTransform {
   std::array<double, 3> translation{0, 0, 0};
   std::array<double, 4> versor{0, 0, 0, 1};  ///< x, y, z, w of R
   double scale = 1.0;
-  double angle_deg = 0.0;                     ///< rotation angle of R
+  double angle_deg = 0.0;  ///< rotation angle of R
 
   std::array<double, 3> apply(const std::array<double, 3>& x) const;
 };
 
 struct RegistrationResult {
   RegistrationTransform transform;
-  std::string metric;         ///< to_string of the metric used
-  double initial_metric = 0;  ///< at the start transform, on the full-resolution images
-  double final_metric = 0;    ///< the same evaluation at the result (lower is better)
+  std::string metric;                                    ///< to_string of the metric used
+  double initial_metric = 0;                             ///< at the start transform, on the full-resolution images
+  double final_metric = 0;                               ///< the same evaluation at the result (lower is better)
   int valid_points_initial = 0, valid_points_final = 0;  ///< of the evaluation samples
-  std::vector<int> iterations;                ///< per level (0 for a level the time budget skipped)
-  std::string stop_condition;                 ///< the optimizer's, at the last level
-  int converged_levels = 0;                   ///< levels stopped by min_relative_change
+  std::vector<int> iterations;                           ///< per level (0 for a level the time budget skipped)
+  std::string stop_condition;                            ///< the optimizer's, at the last level
+  int converged_levels = 0;                              ///< levels stopped by min_relative_change
   std::array<std::size_t, 3> moving_crop_size{0, 0, 0};
-  double edge_radius_mm = 0;                  ///< the radius the parameter scales used
-  double seconds = 0;                         ///< everything, crop and evaluations included
-  double cpu_seconds = 0;                     ///< process CPU time over the same span (all threads)
-  double setup_seconds = 0;                   ///< crop, copies, parameter scales
-  double evaluation_seconds = 0;              ///< the two metric evaluations
-  double optimization_seconds = 0;            ///< the levels: block means and ITK's optimization
+  double edge_radius_mm = 0;        ///< the radius the parameter scales used
+  double seconds = 0;               ///< everything, crop and evaluations included
+  double cpu_seconds = 0;           ///< process CPU time over the same span (all threads)
+  double setup_seconds = 0;         ///< crop, copies, parameter scales
+  double evaluation_seconds = 0;    ///< the two metric evaluations
+  double optimization_seconds = 0;  ///< the levels: block means and ITK's optimization
 };
 
 /// Registers `fixed` to `moving` with a Similarity3DTransform (versor, translation, scale)
@@ -114,7 +114,8 @@ struct RegistrationResult {
 /// \pre both volumes have data of their size; the fixed image has at least 8 voxels per axis.
 /// \throw InputError if the fixed image is too small or does not overlap the moving image.
 /// \throw AlgorithmError if ITK fails (e.g. too few samples land in the moving image).
-RegistrationResult register_similarity(const Volume& fixed, const Volume& moving, const RegistrationOptions& options = {});
+RegistrationResult register_similarity(const Volume& fixed, const Volume& moving,
+                                       const RegistrationOptions& options = {});
 
 /// The box of `image` (voxel indices, inclusive) covering the physical points, grown by
 /// margin_fraction of its size per side plus margin_mm, clamped to the image. Returns false

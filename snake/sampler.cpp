@@ -42,7 +42,7 @@ namespace {
 struct TrilinearCell {
   double fx, fy, fz;
   double c000, c100, c010, c110, c001, c101, c011, c111;  // corner values
-  double c00, c10, c01, c11, c0, c1;                       // blends along x, then y
+  double c00, c10, c01, c11, c0, c1;                      // blends along x, then y
   double value() const { return c0 + fz * (c1 - c0); }
 };
 
@@ -123,8 +123,7 @@ float VolumeSampler::value_and_gradient(const Eigen::Vector3d& p, Eigen::Vector3
 
 bool VolumeSampler::inside(const Eigen::Vector3d& p) const {
   const Eigen::Vector3d idx = to_index(p);
-  return idx.x() >= 0 && idx.y() >= 0 && idx.z() >= 0 && idx.x() <= nx_ - 1 && idx.y() <= ny_ - 1 &&
-         idx.z() <= nz_ - 1;
+  return idx.x() >= 0 && idx.y() >= 0 && idx.z() >= 0 && idx.x() <= nx_ - 1 && idx.y() <= ny_ - 1 && idx.z() <= nz_ - 1;
 }
 
 }  // namespace mrsnake

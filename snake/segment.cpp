@@ -26,7 +26,8 @@ InitMode parse_init_mode(const std::string& name) {
   if (name == "moments") return InitMode::moments;
   if (name == "moments+fit") return InitMode::moments_and_fit;
   if (name == "fit") return InitMode::fit;
-  throw InputError("unknown initialization '" + name + "'; use auto, pose, moments, moments+fit, fit, register or register+fit");
+  throw InputError("unknown initialization '" + name +
+                   "'; use auto, pose, moments, moments+fit, fit, register or register+fit");
 }
 
 std::string to_string(InitMode mode) {
@@ -94,9 +95,9 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   const double step_residual = model.appearance && options.force == ForceMode::automatic
                                    ? profile_step_residual(*model.appearance, model.connectivity.faces)
                                    : std::numeric_limits<double>::infinity();
-  const bool use_profiles = options.force == ForceMode::profile ||
-                            (options.force == ForceMode::automatic && model.appearance.has_value() &&
-                             !(step_residual <= options.clean_step_max_residual));
+  const bool use_profiles =
+      options.force == ForceMode::profile || (options.force == ForceMode::automatic && model.appearance.has_value() &&
+                                              !(step_residual <= options.clean_step_max_residual));
   SegmentResult result;
   result.force = use_profiles ? "profile" : "step_edge";
   result.profile_step_residual = step_residual;
@@ -138,7 +139,8 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   std::vector<VolumeSampler> samplers;
   samplers.reserve(pyramid.size());
   for (std::size_t k = 0; k < pyramid.size(); ++k)
-    samplers.emplace_back(*pyramid[k], k == 0 && level0_raw ? norm_scale : 1.0, k == 0 && level0_raw ? norm_offset : 0.0);
+    samplers.emplace_back(*pyramid[k], k == 0 && level0_raw ? norm_scale : 1.0,
+                          k == 0 && level0_raw ? norm_offset : 0.0);
   end_stage("pyramid");
 
   // Which pyramid level each mesh level runs on, and its search.
@@ -211,8 +213,8 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     MomentsOptions mo = options.moments;
     if (model.appearance && std::isnan(mo.threshold)) {
       // Towards the inside class: a neighbour of intermediate intensity stays out.
-      mo.threshold = model.appearance->region.outside +
-                     0.7 * (model.appearance->region.inside - model.appearance->region.outside);
+      mo.threshold =
+          model.appearance->region.outside + 0.7 * (model.appearance->region.inside - model.appearance->region.outside);
       mo.bright_object = model.appearance->region.inside > model.appearance->region.outside;
     }
     return moments_alignment(*pyramid[p], TriMesh{model.levels[jm], model.faces(jm)}, mo);
@@ -264,8 +266,9 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   // are usually framed like the reference. The fit with the lowest search cost wins (every
   // start is scored with the same statistics).
   const bool from_moments = init == InitMode::moments || init == InitMode::moments_and_fit;
-  std::vector<std::pair<Similarity, std::string>> starts{
-      {pose, registered ? "registration" : from_moments ? "moments" : "model pose"}};
+  std::vector<std::pair<Similarity, std::string>> starts{{pose, registered     ? "registration"
+                                                                : from_moments ? "moments"
+                                                                               : "model pose"}};
   if (!registered && pose.rotation_angle_deg() > 1.0) {
     const Eigen::Vector3d c = model.levels[0].colwise().mean().transpose();
     Similarity unrotated = pose;
@@ -362,7 +365,8 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     // The fold test inside the run is local; a surface can still pass through itself.
     // (A level only synthesized has not moved from its start: nothing to undo.)
     if (options.undo_self_intersections && out.deformed)
-      out.rolled_back_vertices = undo_self_intersections(V, V_level_start, model.faces(j), snake.rings()).moved_vertices;
+      out.rolled_back_vertices =
+          undo_self_intersections(V, V_level_start, model.faces(j), snake.rings()).moved_vertices;
     out.seconds = seconds_since(t_level);
     out.surface = TriMesh{V, model.faces(j)};
     result.levels.push_back(std::move(out));
@@ -391,19 +395,18 @@ nlohmann::json segment_report(const SegmentResult& r) {
   j["intensity_window"] = {{"low", r.window.low}, {"high", r.window.high}};
   j["region"] = {{"inside", r.region.inside}, {"outside", r.region.outside}};
   const Eigen::AngleAxisd aa(r.initial_pose.rotation);
-  j["initial_pose"] = {{"scale", r.initial_pose.scale},
-                       {"rotation_deg", aa.angle() * 180.0 / M_PI},
-                       {"translation_mm", {r.initial_pose.translation.x(), r.initial_pose.translation.y(),
-                                           r.initial_pose.translation.z()}},
-                       {"fit_iterations", r.fit_iterations}};
+  j["initial_pose"] = {
+      {"scale", r.initial_pose.scale},
+      {"rotation_deg", aa.angle() * 180.0 / M_PI},
+      {"translation_mm",
+       {r.initial_pose.translation.x(), r.initial_pose.translation.y(), r.initial_pose.translation.z()}},
+      {"fit_iterations", r.fit_iterations}};
   if (!r.fit_start.empty()) j["initial_pose"]["fit_start"] = r.fit_start;
   j["init_used"] = to_string(r.init);
   if (r.registration) {
     const ReferenceRegistration& g = *r.registration;
-    nlohmann::json reg{{"accepted", g.accepted},
-                       {"ran", g.ran},
-                       {"seconds", g.seconds},
-                       {"pyramid_level", g.pyramid_level}};
+    nlohmann::json reg{
+        {"accepted", g.accepted}, {"ran", g.ran}, {"seconds", g.seconds}, {"pyramid_level", g.pyramid_level}};
     if (!g.accepted) {
       reg["rejection"] = g.rejection;
       reg["fallback"] = to_string(r.init);

@@ -38,12 +38,12 @@ struct SnakeModel {
 };
 
 enum class InitMode {
-  automatic,             ///< register+fit when the model has a reference image, else moments+fit (default)
-  pose,                  ///< the model's physical pose as is
-  moments,               ///< + moments of a rough threshold
-  moments_and_fit,       ///< + a similarity fit of the coarse mesh to its search targets (also tried from the model's pose)
-  fit,                   ///< the model's pose + the fit
-  registration,          ///< + registration of the model's reference image to the image
+  automatic,        ///< register+fit when the model has a reference image, else moments+fit (default)
+  pose,             ///< the model's physical pose as is
+  moments,          ///< + moments of a rough threshold
+  moments_and_fit,  ///< + a similarity fit of the coarse mesh to its search targets (also tried from the model's pose)
+  fit,              ///< the model's pose + the fit
+  registration,     ///< + registration of the model's reference image to the image
   registration_and_fit,  ///< + the registration, then the fit
 };
 /// \throw InputError for an unknown name (auto, pose, moments, moments+fit, fit, register, register+fit).
@@ -109,9 +109,9 @@ struct SegmentOptions {
   /// coarsest level uses coarse_range_edge_fraction for the initial fit.
   double range_edge_fraction = 0.5;
   double coarse_range_edge_fraction = 0.75;
-  double min_range_voxels = 1.0;      ///< levels: the search range is at least this many voxels
-  double fit_min_range_voxels = 4.0;  ///< the initial fit's search range is at least this many voxels
-  double step_voxels = 0.5;       ///< search step, in voxels of the pyramid level
+  double min_range_voxels = 1.0;       ///< levels: the search range is at least this many voxels
+  double fit_min_range_voxels = 4.0;   ///< the initial fit's search range is at least this many voxels
+  double step_voxels = 0.5;            ///< search step, in voxels of the pyramid level
   double profile_step_fraction = 0.5;  ///< profile search step, as a fraction of the profile spacing
   /// The search range is at most this many voxels of the pyramid level (0: no cap), on the
   /// levels and in the initial fit.
@@ -169,18 +169,19 @@ struct LevelOutcome {
   int vertices = 0;
   SnakeLevelReport snake;
   int rolled_back_vertices = 0;  ///< vertices moved back to undo self-intersections
-  bool deformed = true;          ///< false: finer than the image (min_edge_voxels) and not deformed as such (FineLevelOptions), only synthesized
-  int offset_smoothing = 0;      ///< ring-averaging passes over the matched offsets (SnakeOptions)
-  double seconds = 0;          ///< synthesis + snake of this level
+  bool deformed = true;  ///< false: finer than the image (min_edge_voxels) and not deformed as such (FineLevelOptions),
+                         ///< only synthesized
+  int offset_smoothing = 0;  ///< ring-averaging passes over the matched offsets (SnakeOptions)
+  double seconds = 0;        ///< synthesis + snake of this level
   double synthesis_seconds = 0;
-  TriMesh surface;             ///< S_j after deformation
+  TriMesh surface;  ///< S_j after deformation
 };
 
 struct SegmentResult {
-  TriMesh surface;             ///< the final level
+  TriMesh surface;  ///< the final level
   std::vector<LevelOutcome> levels;
-  Similarity initial_pose;     ///< applied to the model's S_0 before the coarse-to-fine run
-  InitMode init = InitMode::pose;  ///< the route taken (auto resolved, after any fallback)
+  Similarity initial_pose;                            ///< applied to the model's S_0 before the coarse-to-fine run
+  InitMode init = InitMode::pose;                     ///< the route taken (auto resolved, after any fallback)
   std::optional<ReferenceRegistration> registration;  ///< when a registration route was asked for
   int fit_iterations = 0;
   /// The start the fit kept: "registration", "moments", "moments without rotation" or
@@ -188,8 +189,8 @@ struct SegmentResult {
   std::string fit_start;
   RegionStats region;
   IntensityWindow window;
-  int self_intersections = -1; ///< -1 when not counted
-  std::string force;           ///< "profile" or "step_edge"
+  int self_intersections = -1;  ///< -1 when not counted
+  std::string force;            ///< "profile" or "step_edge"
   /// profile_step_residual of the model's appearance (appearance.h) when the force was
   /// chosen automatically; +infinity otherwise.
   double profile_step_residual = std::numeric_limits<double>::infinity();

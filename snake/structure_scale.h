@@ -16,10 +16,10 @@ namespace mrsnake {
 /// What a label volume says about the size of one structure (all voxels of the label: every
 /// connected part of it).
 struct StructureScale {
-  double finest_voxel_mm = 0;          ///< the smallest voxel side of the label volume
-  double largest_voxel_mm = 0;         ///< the largest voxel side
-  double volume_mm3 = 0;               ///< voxels of the label × voxel volume
-  double equivalent_radius_mm = 0;     ///< radius of the sphere of that volume
+  double finest_voxel_mm = 0;       ///< the smallest voxel side of the label volume
+  double largest_voxel_mm = 0;      ///< the largest voxel side
+  double volume_mm3 = 0;            ///< voxels of the label × voxel volume
+  double equivalent_radius_mm = 0;  ///< radius of the sphere of that volume
   /// Bounding box of the label's voxel centres along the physical axes, grown by the largest
   /// voxel side.
   std::array<double, 3> extent_mm{0, 0, 0};

@@ -12,7 +12,7 @@ namespace mrsnake {
 
 /// The 1-ring of every vertex of a fixed connectivity, in compressed rows.
 struct VertexRings {
-  std::vector<int> offsets;    ///< ring of v: neighbors[offsets[v] .. offsets[v+1])
+  std::vector<int> offsets;  ///< ring of v: neighbors[offsets[v] .. offsets[v+1])
   std::vector<int> neighbors;
   int num_vertices() const { return static_cast<int>(offsets.size()) - 1; }
   int valence(int v) const { return offsets[v + 1] - offsets[v]; }

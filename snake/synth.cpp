@@ -86,8 +86,7 @@ double arc_distance(const ShapeParams& s, const Eigen::Vector3d& x) {
   const Eigen::Vector3d c(0, s.arc_offset - s.arc_radius, 0);
   const Eigen::Vector3d q = x - c;
   const double theta = std::atan2(q.y(), q.x());
-  if (std::abs(theta - kPi / 2) <= s.arc_half_angle)
-    return std::hypot(std::hypot(q.x(), q.y()) - s.arc_radius, q.z());
+  if (std::abs(theta - kPi / 2) <= s.arc_half_angle) return std::hypot(std::hypot(q.x(), q.y()) - s.arc_radius, q.z());
   double best = std::numeric_limits<double>::infinity();
   for (double sign : {-1.0, 1.0}) {
     const double a = kPi / 2 + sign * s.arc_half_angle;
@@ -205,7 +204,8 @@ Eigen::Vector3d voxel_centre(const Volume& v, double i, double j, double k) {
 void validate(const SynthOptions& o) {
   auto bad = [](const std::string& m) { throw InputError(m); };
   for (int d = 0; d < 3; ++d) {
-    if (!o.from_image() && (o.size[d] < 8 || o.size[d] > 2048)) bad("--size must be between 8 and 2048 voxels per axis");
+    if (!o.from_image() && (o.size[d] < 8 || o.size[d] > 2048))
+      bad("--size must be between 8 and 2048 voxels per axis");
     if (!o.from_image() && !(std::isfinite(o.spacing[d]) && o.spacing[d] > 0)) bad("--spacing must be positive");
   }
   if (!(std::isfinite(o.snr))) bad("--snr must be a finite number (<= 0 for no noise)");
@@ -234,7 +234,8 @@ DeformationParams draw_deformation(double amplitude, const Eigen::Vector3d& lo, 
   }
   const int n = 32;  // samples per axis of the box: under a third of the bump width apart
   auto sample = [&](int i, int j, int k) {
-    return Eigen::Vector3d(box_lo.x() + (box_hi.x() - box_lo.x()) * i / (n - 1), box_lo.y() + (box_hi.y() - box_lo.y()) * j / (n - 1),
+    return Eigen::Vector3d(box_lo.x() + (box_hi.x() - box_lo.x()) * i / (n - 1),
+                           box_lo.y() + (box_hi.y() - box_lo.y()) * j / (n - 1),
                            box_lo.z() + (box_hi.z() - box_lo.z()) * k / (n - 1));
   };
   double largest = 0;
@@ -248,7 +249,8 @@ DeformationParams draw_deformation(double amplitude, const Eigen::Vector3d& lo, 
   for (int k = 0; k < n; ++k)
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i)
-        smallest_det = std::min(smallest_det, (Eigen::Matrix3d::Identity() + u.jacobian(sample(i, j, k))).determinant());
+        smallest_det =
+            std::min(smallest_det, (Eigen::Matrix3d::Identity() + u.jacobian(sample(i, j, k))).determinant());
   for (const auto& c : u.centres)
     smallest_det = std::min(smallest_det, (Eigen::Matrix3d::Identity() + u.jacobian(c)).determinant());
   if (smallest_det < 0.2) {
@@ -302,28 +304,32 @@ void degrade(Volume& image, const SynthParams& p, double contrast, const Progres
 }
 
 /// Moves each vertex onto the zero level of f by Newton steps along the gradient.
-void project_onto_surface(RowMatrixX3d& V, const std::function<double(const Eigen::Vector3d&)>& f, double h, double max_step) {
-  parallel_ranges(static_cast<std::size_t>(V.rows()), [&](std::size_t begin, std::size_t end) {
-    for (int v = static_cast<int>(begin); v < static_cast<int>(end); ++v) {
-      Eigen::Vector3d x = V.row(v).transpose();
-      for (int it = 0; it < 10; ++it) {
-        const double fx = f(x);
-        if (std::abs(fx) < 1e-9) break;
-        Eigen::Vector3d g;
-        for (int d = 0; d < 3; ++d) {
-          Eigen::Vector3d e = Eigen::Vector3d::Zero();
-          e[d] = h;
-          g[d] = (f(x + e) - f(x - e)) / (2 * h);
+void project_onto_surface(RowMatrixX3d& V, const std::function<double(const Eigen::Vector3d&)>& f, double h,
+                          double max_step) {
+  parallel_ranges(
+      static_cast<std::size_t>(V.rows()),
+      [&](std::size_t begin, std::size_t end) {
+        for (int v = static_cast<int>(begin); v < static_cast<int>(end); ++v) {
+          Eigen::Vector3d x = V.row(v).transpose();
+          for (int it = 0; it < 10; ++it) {
+            const double fx = f(x);
+            if (std::abs(fx) < 1e-9) break;
+            Eigen::Vector3d g;
+            for (int d = 0; d < 3; ++d) {
+              Eigen::Vector3d e = Eigen::Vector3d::Zero();
+              e[d] = h;
+              g[d] = (f(x + e) - f(x - e)) / (2 * h);
+            }
+            const double g2 = g.squaredNorm();
+            if (g2 < 1e-12) break;
+            Eigen::Vector3d step = fx * g / g2;
+            if (step.norm() > max_step) step *= max_step / step.norm();
+            x -= step;
+          }
+          V.row(v) = x.transpose();
         }
-        const double g2 = g.squaredNorm();
-        if (g2 < 1e-12) break;
-        Eigen::Vector3d step = fx * g / g2;
-        if (step.norm() > max_step) step *= max_step / step.norm();
-        x -= step;
-      }
-      V.row(v) = x.transpose();
-    }
-  }, 4);
+      },
+      4);
 }
 
 }  // namespace
@@ -387,8 +393,15 @@ Eigen::Matrix3d DeformationParams::jacobian(const Eigen::Vector3d& p) const {
 double BiasParams::factor(const Eigen::Vector3d& p) const {
   if (strength <= 0) return 1.0;
   const Eigen::Vector3d x = (p - centre).cwiseQuotient(half_extent);
-  const double m[9] = {x.x(), x.y(), x.z(), x.x() * x.x() - 1.0 / 3, x.y() * x.y() - 1.0 / 3, x.z() * x.z() - 1.0 / 3,
-                       x.x() * x.y(), x.y() * x.z(), x.z() * x.x()};
+  const double m[9] = {x.x(),
+                       x.y(),
+                       x.z(),
+                       x.x() * x.x() - 1.0 / 3,
+                       x.y() * x.y() - 1.0 / 3,
+                       x.z() * x.z() - 1.0 / 3,
+                       x.x() * x.y(),
+                       x.y() * x.z(),
+                       x.z() * x.x()};
   double g = 0;
   for (int i = 0; i < 9; ++i) g += coefficients[i] * m[i];
   return std::exp(strength * g);
@@ -467,8 +480,8 @@ SynthParams draw_synth_params(const SynthOptions& options, const Volume* source_
   Rng deform_rng(options.seed, kDeformStream);
   p.deformation = draw_deformation(options.deform_mm, lo, hi, box_lo, box_hi, fov, deform_rng);
   Rng bias_rng(options.seed, kBiasStream);
-  p.bias_field = draw_bias(options.bias, 0.5 * (box_lo + box_hi), 0.5 * (box_hi - box_lo).cwiseMax(Eigen::Vector3d::Constant(1e-6)),
-                           bias_rng);
+  p.bias_field = draw_bias(options.bias, 0.5 * (box_lo + box_hi),
+                           0.5 * (box_hi - box_lo).cwiseMax(Eigen::Vector3d::Constant(1e-6)), bias_rng);
   return p;
 }
 
@@ -481,7 +494,8 @@ SynthResult render_synth(const SynthParams& params, const ProgressFn& progress) 
   // The object's and (heart) the outer wall's functions, sharing one mapping of the point.
   auto both = [&](const Eigen::Vector3d& p) {
     const Eigen::Vector3d x = params.to_reference(p);
-    return std::pair<double, double>(s * shape_function(params.shape, x), heart ? s * heart_outer_function(params.shape, x) : 1.0);
+    return std::pair<double, double>(s * shape_function(params.shape, x),
+                                     heart ? s * heart_outer_function(params.shape, x) : 1.0);
   };
   const double mid = 0.5 * (o.foreground + o.background);
   auto tissue = [&](const Eigen::Vector3d& p) {
@@ -540,9 +554,10 @@ SynthResult render_synth(const SynthParams& params, const ProgressFn& progress) 
           const auto [v, w] = both(c);
           const bool border = i < 2 || j < 2 || k < 2 || i + 2 >= nx || j + 2 >= ny || k + 2 >= nz;
           if (border && v <= 0)
-            throw InputError("the " + to_string(params.shape.kind) +
-                             " does not fit inside the image (it reaches the border); use a larger --size or --spacing, "
-                             "a smaller --deform, or another --seed");
+            throw InputError(
+                "the " + to_string(params.shape.kind) +
+                " does not fit inside the image (it reaches the border); use a larger --size or --spacing, "
+                "a smaller --deform, or another --seed");
           field.at(i, j, k) = static_cast<float>(v);
           r.truth.at(i, j, k) = v < 0 ? kTruthLabel : (heart && w < 0 ? kWallLabel : 0);
           const bool mixed = is_mixed(obj_lo, obj_hi, v, i, j) || (heart && is_mixed(out_lo, out_hi, w, i, j));
@@ -554,7 +569,8 @@ SynthResult render_synth(const SynthParams& params, const ProgressFn& progress) 
             for (int a = 0; a < n; ++a)
               for (int b = 0; b < n; ++b)
                 for (int e = 0; e < n; ++e)
-                  sum += tissue(voxel_centre(r.truth, i + (e + 0.5) / n - 0.5, j + (b + 0.5) / n - 0.5, k + (a + 0.5) / n - 0.5));
+                  sum += tissue(
+                      voxel_centre(r.truth, i + (e + 0.5) / n - 0.5, j + (b + 0.5) / n - 0.5, k + (a + 0.5) / n - 0.5));
             value = sum / (n * n * n);
           }
           r.image.at(i, j, k) = static_cast<float>(value);
@@ -564,7 +580,8 @@ SynthResult render_synth(const SynthParams& params, const ProgressFn& progress) 
     }
   };
   // The slab starting at 0 runs on the calling thread: it reports the progress.
-  parallel_ranges(nz, [&](std::size_t k0, std::size_t k1) { render_slab(k0, k1, k0 == 0); }, 4);
+  parallel_ranges(
+      nz, [&](std::size_t k0, std::size_t k1) { render_slab(k0, k1, k0 == 0); }, 4);
   report(progress, "synth: shape", 1.0);
 
   degrade(r.image, params, o.foreground - o.background, progress);
@@ -636,7 +653,8 @@ using nlohmann::json;
 
 json to_j(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
 Eigen::Vector3d vec_from(const json& j) {
-  if (!j.is_array() || j.size() != 3) throw InputError("malformed synth parameters: expected an array of 3 numbers, got " + j.dump());
+  if (!j.is_array() || j.size() != 3)
+    throw InputError("malformed synth parameters: expected an array of 3 numbers, got " + j.dump());
   return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()};
 }
 std::vector<Eigen::Vector3d> vecs_from(const json& j) {
@@ -727,7 +745,9 @@ SynthParams synth_params_from_json(const nlohmann::json& j) {
   SynthOptions& o = p.options;
   try {
     if (j.value("format", std::string()) != "mrsnake synth parameters")
-      throw InputError("not an mrsnake synth parameter file (no \"format\": \"mrsnake synth parameters\"); give the params.json written by 'mrsnake synth'");
+      throw InputError(
+          "not an mrsnake synth parameter file (no \"format\": \"mrsnake synth parameters\"); give the params.json "
+          "written by 'mrsnake synth'");
     o.seed = j.at("seed").get<std::uint64_t>();
     o.size = j.at("size").get<std::array<int, 3>>();
     o.spacing = j.at("spacing").get<std::array<double, 3>>();
@@ -759,7 +779,8 @@ SynthParams synth_params_from_json(const nlohmann::json& j) {
           s.bump_directions = vecs_from(sj.at("bump_directions"));
           s.bump_heights = sj.at("bump_heights").get<std::vector<double>>();
           s.bump_concentrations = sj.at("bump_concentrations").get<std::vector<double>>();
-          if (s.bump_heights.size() != s.bump_directions.size() || s.bump_concentrations.size() != s.bump_directions.size())
+          if (s.bump_heights.size() != s.bump_directions.size() ||
+              s.bump_concentrations.size() != s.bump_directions.size())
             throw InputError("params: the blob's bump lists differ in length");
           break;
         case SynthShape::aneurysm:
@@ -801,7 +822,8 @@ SynthParams synth_params_from_json(const nlohmann::json& j) {
     p.bias_field.half_extent = vec_from(b.at("half_extent"));
     p.bias_field.coefficients = b.at("coefficients").get<std::array<double, 9>>();
   } catch (const nlohmann::json::exception& e) {
-    throw InputError(std::string("malformed synth parameters: ") + e.what() + "; give the params.json written by 'mrsnake synth'");
+    throw InputError(std::string("malformed synth parameters: ") + e.what() +
+                     "; give the params.json written by 'mrsnake synth'");
   }
   if (!(p.pose.scale > 0) || !(p.deformation.width_mm > 0))
     throw InputError("malformed synth parameters: similarity.scale and deformation.width_mm must be positive");

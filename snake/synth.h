@@ -38,24 +38,24 @@ std::string to_string(SynthNoise noise);
 /// What the user chooses. Defaults give a small, fast case.
 struct SynthOptions {
   SynthShape shape = SynthShape::sphere;
-  std::array<int, 3> size{64, 64, 64};             ///< voxels
-  std::array<double, 3> spacing{1.0, 1.0, 1.0};    ///< mm; anisotropic allowed
+  std::array<int, 3> size{64, 64, 64};           ///< voxels
+  std::array<double, 3> spacing{1.0, 1.0, 1.0};  ///< mm; anisotropic allowed
   SynthNoise noise = SynthNoise::gaussian;
   /// Signal-to-noise ratio, defined as |foreground − background| / σ, σ the standard
   /// deviation of the Gaussian noise (of each channel for Rician). <= 0 means no noise.
   double snr = 10.0;
-  double blur_mm = 0.5;        ///< standard deviation of the Gaussian blur in mm (0: none)
+  double blur_mm = 0.5;  ///< standard deviation of the Gaussian blur in mm (0: none)
   /// Strength B of the smooth multiplicative bias field exp(B·g(x)), |g| <= 1, so the
   /// field lies within [e^−B, e^B]. 0: none.
   double bias = 0.0;
-  double foreground = 200.0;   ///< intensity inside the object (the heart's cavity)
-  double background = 50.0;    ///< intensity outside (the heart's wall; its surroundings
-                               ///< take the mean of both)
-  bool random_pose = false;    ///< random similarity: rotation <= 15°, shift <= 5% of the
-                               ///< field of view, scale in [0.9, 1.1]
-  double deform_mm = 0.0;      ///< largest displacement of the random smooth deformation
+  double foreground = 200.0;  ///< intensity inside the object (the heart's cavity)
+  double background = 50.0;   ///< intensity outside (the heart's wall; its surroundings
+                              ///< take the mean of both)
+  bool random_pose = false;   ///< random similarity: rotation <= 15°, shift <= 5% of the
+                              ///< field of view, scale in [0.9, 1.1]
+  double deform_mm = 0.0;     ///< largest displacement of the random smooth deformation
   std::uint64_t seed = 1;
-  int supersampling = 4;       ///< partial volume: n³ samples in each boundary voxel
+  int supersampling = 4;  ///< partial volume: n³ samples in each boundary voxel
 
   /// --from-image mode: warp a real image and its label `source_label` instead of
   /// rendering a shape (the shape, contrast and supersampling are then unused).
@@ -69,8 +69,8 @@ struct SynthOptions {
 /// Lengths in mm, in the reference frame centred on the origin of the shape.
 struct ShapeParams {
   SynthShape kind = SynthShape::sphere;
-  double radius = 0;                    ///< sphere
-  Eigen::Vector3d semi_axes{0, 0, 0};   ///< ellipsoid; heart: the cavity's
+  double radius = 0;                   ///< sphere
+  Eigen::Vector3d semi_axes{0, 0, 0};  ///< ellipsoid; heart: the cavity's
   // blob: r(u) = base_radius·(1 + Σ h_k·exp(κ_k·(u·n_k − 1))) for unit directions u
   double base_radius = 0;
   std::vector<Eigen::Vector3d> bump_directions;

@@ -72,8 +72,8 @@ inline CommandResult run_mrsnake(const std::string& args) {
 }  // namespace mrsnake::test
 
 /// Skips the test with a clear message when a shared data file is absent.
-#define MRSNAKE_REQUIRE_DATA(var, relative)                                                        \
-  const std::string var = ::mrsnake::test::data_file(relative);                                     \
-  if (var.empty())                                                                                  \
-    GTEST_SKIP() << "shared data file '" << relative << "' not found under "                       \
-                 << ::mrsnake::test::data_dir() << " (set MRSNAKE_DATA to the shared data folder)"
+#define MRSNAKE_REQUIRE_DATA(var, relative)                                                               \
+  const std::string var = ::mrsnake::test::data_file(relative);                                           \
+  if (var.empty())                                                                                        \
+  GTEST_SKIP() << "shared data file '" << relative << "' not found under " << ::mrsnake::test::data_dir() \
+               << " (set MRSNAKE_DATA to the shared data folder)"

@@ -56,7 +56,8 @@ std::vector<Ring> build_rings(const RowMatrixX3i& F, int n) {
     };
     for (int i = offsets[v]; i < offsets[v + 1] && ok; ++i) {
       const int x = node_of(links[i].first), y = node_of(links[i].second);
-      if (x == y) ok = false;
+      if (x == y)
+        ok = false;
       else {
         connect(x, y);
         connect(y, x);
@@ -76,17 +77,22 @@ std::vector<Ring> build_rings(const RowMatrixX3i& F, int n) {
       ring.vertices.push_back(nodes[current].vertex);
       const Node& node = nodes[current];
       int next;
-      if (node.degree == 1) next = node.link[0] != previous ? node.link[0] : -1;
-      else next = node.link[0] != previous ? node.link[0] : node.link[1];
+      if (node.degree == 1)
+        next = node.link[0] != previous ? node.link[0] : -1;
+      else
+        next = node.link[0] != previous ? node.link[0] : node.link[1];
       previous = current;
       current = next;
       if (current < 0) break;
     }
     const bool closed = ends == 0 && current == start;
     const bool complete = ring.vertices.size() == nodes.size();
-    if (complete && ends == 2) ring.kind = Ring::Kind::boundary;
-    else if (complete && closed && ring.vertices.size() >= 3) ring.kind = Ring::Kind::interior;
-    else ring.vertices.clear();
+    if (complete && ends == 2)
+      ring.kind = Ring::Kind::boundary;
+    else if (complete && closed && ring.vertices.size() >= 3)
+      ring.kind = Ring::Kind::interior;
+    else
+      ring.vertices.clear();
   }
   return rings;
 }
@@ -117,9 +123,12 @@ bool extraordinary_stencil(const Ring& ring, int e, int other, double factor, St
   out.add(e, 0.75 * factor);
   for (int i = 0; i < k; ++i) {
     double w;
-    if (k == 3) w = i == 0 ? 5.0 / 12.0 : -1.0 / 12.0;
-    else if (k == 4) w = i == 0 ? 3.0 / 8.0 : (i == 2 ? -1.0 / 8.0 : 0.0);
-    else w = (0.25 + std::cos(2.0 * kPi * i / k) + 0.5 * std::cos(4.0 * kPi * i / k)) / k;
+    if (k == 3)
+      w = i == 0 ? 5.0 / 12.0 : -1.0 / 12.0;
+    else if (k == 4)
+      w = i == 0 ? 3.0 / 8.0 : (i == 2 ? -1.0 / 8.0 : 0.0);
+    else
+      w = (0.25 + std::cos(2.0 * kPi * i / k) + 0.5 * std::cos(4.0 * kPi * i / k)) / k;
     if (w != 0.0) out.add(ring.vertices[(i0 + i) % k], w * factor);
   }
   return true;
@@ -139,7 +148,8 @@ PredictScheme parse_predict_scheme(const std::string& name) {
 WaveletTransform::WaveletTransform(SubdivisionConnectivity conn, WaveletOptions options)
     : conn_(std::move(conn)), options_(options) {
   if (conn_.faces.empty() || conn_.vertex_counts.size() != conn_.faces.size())
-    throw TopologyError("the mesh hierarchy is empty or its level counts disagree; rebuild it with subdivide_connectivity");
+    throw TopologyError(
+        "the mesh hierarchy is empty or its level counts disagree; rebuild it with subdivide_connectivity");
   levels_.resize(conn_.levels());
   for (int j = 0; j < conn_.levels(); ++j) build_level(j);
 }
@@ -167,9 +177,12 @@ void WaveletTransform::build_level(int j) {
       const Eigen::Vector2i p = conn_.parents(mid);
       if (!((p[0] == a && p[1] == b) || (p[0] == b && p[1] == a))) throw bad("a new vertex is not on its parent edge");
       int* slot = &level.edge_faces[2 * static_cast<std::size_t>(mid - nc)];
-      if (slot[0] < 0) slot[0] = f;
-      else if (slot[1] < 0) slot[1] = f;
-      else throw bad("an edge has more than two faces");
+      if (slot[0] < 0)
+        slot[0] = f;
+      else if (slot[1] < 0)
+        slot[1] = f;
+      else
+        throw bad("an edge has more than two faces");
     }
   std::vector<int> valence(nc, 0);
   for (int i = 0; i < m; ++i) {
@@ -200,8 +213,10 @@ void WaveletTransform::build_level(int j) {
       const bool boundary_edge = level.edge_faces[2 * static_cast<std::size_t>(i) + 1] < 0;
       if (boundary_edge) {
         if (ra.kind == K::boundary && rb.kind == K::boundary) {
-          const int pa = ra.vertices.front() == b ? ra.vertices.back() : (ra.vertices.back() == b ? ra.vertices.front() : -1);
-          const int qb = rb.vertices.front() == a ? rb.vertices.back() : (rb.vertices.back() == a ? rb.vertices.front() : -1);
+          const int pa =
+              ra.vertices.front() == b ? ra.vertices.back() : (ra.vertices.back() == b ? ra.vertices.front() : -1);
+          const int qb =
+              rb.vertices.front() == a ? rb.vertices.back() : (rb.vertices.back() == a ? rb.vertices.front() : -1);
           if (pa >= 0 && qb >= 0 && pa != qb && pa != b && qb != a) {
             s.add(pa, -1.0 / 16.0);
             s.add(a, 9.0 / 16.0);
@@ -290,7 +305,8 @@ std::vector<LocalFrame> WaveletTransform::frames(int j, const RowMatrixX3d& coar
   RowMatrixX3d face_normals(F.rows(), 3);
   for (int f = 0; f < F.rows(); ++f) {
     const Eigen::Vector3d q0 = coarse.row(F(f, 0)).transpose();
-    face_normals.row(f) = (coarse.row(F(f, 1)).transpose() - q0).cross(coarse.row(F(f, 2)).transpose() - q0).transpose();
+    face_normals.row(f) =
+        (coarse.row(F(f, 1)).transpose() - q0).cross(coarse.row(F(f, 2)).transpose() - q0).transpose();
   }
   double total_length = 0.0;
   for (int i = 0; i < m; ++i) {
@@ -301,7 +317,8 @@ std::vector<LocalFrame> WaveletTransform::frames(int j, const RowMatrixX3d& coar
   std::vector<LocalFrame> result(m);
   for (int i = 0; i < m; ++i) {
     const Eigen::Vector2i p = conn_.parents(level.n_coarse + i);
-    const int f0 = level.edge_faces[2 * static_cast<std::size_t>(i)], f1 = level.edge_faces[2 * static_cast<std::size_t>(i) + 1];
+    const int f0 = level.edge_faces[2 * static_cast<std::size_t>(i)],
+              f1 = level.edge_faces[2 * static_cast<std::size_t>(i) + 1];
     Eigen::Vector3d n = face_normals.row(f0).transpose();
     if (f1 >= 0) n += face_normals.row(f1).transpose();
     result[i] = parent_edge_frame(coarse.row(p[0]).transpose(), coarse.row(p[1]).transpose(), n, reference_length,
@@ -374,7 +391,8 @@ WaveletAnalysis WaveletTransform::analyze(const RowMatrixX3d& finest) const {
   return a;
 }
 
-RowMatrixX3d WaveletTransform::synthesize(const RowMatrixX3d& base, const std::vector<RowMatrixX3d>& details, int level) const {
+RowMatrixX3d WaveletTransform::synthesize(const RowMatrixX3d& base, const std::vector<RowMatrixX3d>& details,
+                                          int level) const {
   const int target = level < 0 ? levels() : level;
   if (target > levels() || static_cast<int>(details.size()) < target)
     throw std::invalid_argument("synthesize: not enough levels of details");

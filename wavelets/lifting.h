@@ -46,7 +46,7 @@ enum class DetailFrame {
 
 struct WaveletOptions {
   PredictScheme predict = PredictScheme::butterfly;
-  bool update = true;                      ///< lift the coarse levels (false: plain subsampling)
+  bool update = true;  ///< lift the coarse levels (false: plain subsampling)
   DetailFrame frame = DetailFrame::local;
   double degenerate_frame_tolerance = 1e-10;  ///< see parent_edge_frame
 };

@@ -33,8 +33,12 @@ LocalFrame parent_edge_frame(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                              double reference_length, double tolerance);
 
 /// Global → local: axesᵀ·d / scale.
-inline Eigen::Vector3d to_local(const LocalFrame& f, const Eigen::Vector3d& d) { return f.axes.transpose() * d / f.scale; }
+inline Eigen::Vector3d to_local(const LocalFrame& f, const Eigen::Vector3d& d) {
+  return f.axes.transpose() * d / f.scale;
+}
 /// Local → global: scale·axes·d_local.
-inline Eigen::Vector3d to_global(const LocalFrame& f, const Eigen::Vector3d& d_local) { return f.scale * (f.axes * d_local); }
+inline Eigen::Vector3d to_global(const LocalFrame& f, const Eigen::Vector3d& d_local) {
+  return f.scale * (f.axes * d_local);
+}
 
 }  // namespace mrsnake

@@ -15,8 +15,9 @@ ShapeModel make_model(const SubdivisionConnectivity& conn, const RowMatrixX3d& f
               rebuilt.parent_edges == conn.parent_edges;
   for (int j = 0; same && j <= conn.levels(); ++j) same = rebuilt.faces[j] == conn.faces[j];
   if (!same)
-    throw TopologyError("the mesh hierarchy's numbering differs from subdivide_connectivity's; a model can only store "
-                        "hierarchies built by it");
+    throw TopologyError(
+        "the mesh hierarchy's numbering differs from subdivide_connectivity's; a model can only store "
+        "hierarchies built by it");
   if (finest.rows() != conn.vertex_counts.back())
     throw std::invalid_argument("make_model: the finest level needs " + std::to_string(conn.vertex_counts.back()) +
                                 " positions, got " + std::to_string(finest.rows()));

@@ -30,18 +30,18 @@ struct PhysicalFrame {
 /// (subdivide_connectivity), so only S_0 and the details carry geometry.
 struct ShapeModel {
   WaveletOptions wavelet;
-  RowMatrixX3i base_faces;                     ///< faces of S_0
-  RowMatrixX3d base;                           ///< S_0 (n_0 rows)
-  std::vector<RowMatrixX3d> details;           ///< D_1..D_L as stored (see lifting.h)
-  std::vector<RowMatrixX3d> level_positions;   ///< S_0..S_L from the analysis (empty when not loaded)
-  std::vector<DetailStats> detail_stats;       ///< per level 1..L
+  RowMatrixX3i base_faces;                    ///< faces of S_0
+  RowMatrixX3d base;                          ///< S_0 (n_0 rows)
+  std::vector<RowMatrixX3d> details;          ///< D_1..D_L as stored (see lifting.h)
+  std::vector<RowMatrixX3d> level_positions;  ///< S_0..S_L from the analysis (empty when not loaded)
+  std::vector<DetailStats> detail_stats;      ///< per level 1..L
 
   // Provenance, written to the manifest.
-  std::string source_image;                    ///< the label image (empty if unknown)
+  std::string source_image;  ///< the label image (empty if unknown)
   std::optional<int> source_label;
-  std::optional<int> source_component;        ///< the label's k-th largest part only (build-model --component)
+  std::optional<int> source_component;  ///< the label's k-th largest part only (build-model --component)
   std::optional<PhysicalFrame> physical_frame;
-  nlohmann::json remesh_quality;               ///< mesh/quality.h keys; null if none
+  nlohmann::json remesh_quality;  ///< mesh/quality.h keys; null if none
   /// The structure's size and every default derived from it, with the finest level's fit to
   /// its label (build-model); null if none.
   nlohmann::json scale;
@@ -60,7 +60,8 @@ struct ShapeModel {
 /// \pre finest has conn.vertex_counts.back() rows of finite values.
 /// \throw TopologyError if conn is not the 1:4 split of its own base faces by
 ///        subdivide_connectivity (the model stores only the base faces and L).
-ShapeModel make_model(const SubdivisionConnectivity& conn, const RowMatrixX3d& finest, const WaveletOptions& options = {});
+ShapeModel make_model(const SubdivisionConnectivity& conn, const RowMatrixX3d& finest,
+                      const WaveletOptions& options = {});
 
 /// Synthesizes S_level (level = -1: S_L) from the model's base and details.
 RowMatrixX3d synthesize(const ShapeModel& model, int level = -1);

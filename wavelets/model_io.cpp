@@ -83,7 +83,8 @@ std::vector<std::uint8_t> encode_details(const ShapeModel& m, const std::vector<
 void decode_details(const std::vector<std::uint8_t>& bytes, const std::string& where, ShapeModel& m,
                     std::vector<int>& counts) {
   const auto fail = [&](const std::string& why) { return InputError(where + " " + why + "; rebuild the model"); };
-  if (bytes.size() < kHeaderBytes + 8) throw fail("is truncated (" + std::to_string(bytes.size()) + " bytes, shorter than its header)");
+  if (bytes.size() < kHeaderBytes + 8)
+    throw fail("is truncated (" + std::to_string(bytes.size()) + " bytes, shorter than its header)");
   if (std::memcmp(bytes.data(), kMagic, 8) != 0) throw fail("is not a mrsnake details file (bad magic bytes)");
   ByteReader r(bytes, 0, fail("is truncated").what());
   r.get<std::uint64_t>();  // magic
@@ -98,7 +99,8 @@ void decode_details(const std::vector<std::uint8_t>& bytes, const std::string& w
   r.get<std::uint32_t>();  // reserved
   if (predict > 1 || update > 1 || frame > 1 || !(tolerance >= 0 && tolerance < 1))
     throw fail("has an unknown wavelet scheme code");
-  if (levels > kMaxLevels) throw fail("claims " + std::to_string(levels) + " levels (at most " + std::to_string(kMaxLevels) + ")");
+  if (levels > kMaxLevels)
+    throw fail("claims " + std::to_string(levels) + " levels (at most " + std::to_string(kMaxLevels) + ")");
   if (n0 < 3 || m0 < 1 || n0 > 50000000u || m0 > 100000000u) throw fail("has invalid base mesh counts");
   // Sizes: checked before reading any array, with 64-bit arithmetic.
   std::uint64_t expected = kHeaderBytes + 4ull * (levels + 1);
@@ -119,7 +121,8 @@ void decode_details(const std::vector<std::uint8_t>& bytes, const std::string& w
     throw fail("has " + std::to_string(bytes.size() - expected) + " unexpected trailing bytes");
   std::uint64_t stored = 0;
   for (int i = 0; i < 8; ++i) stored |= static_cast<std::uint64_t>(bytes[expected - 8 + i]) << (8 * i);
-  if (stored != fnv1a64(bytes.data(), expected - 8)) throw fail("was altered or corrupted (its checksum does not match)");
+  if (stored != fnv1a64(bytes.data(), expected - 8))
+    throw fail("was altered or corrupted (its checksum does not match)");
 
   m.wavelet.predict = predict == 0 ? PredictScheme::linear : PredictScheme::butterfly;
   m.wavelet.update = update == 1;
@@ -177,11 +180,12 @@ std::vector<std::uint8_t> read_part(const fs::path& dir, const nlohmann::json& e
   std::vector<std::uint8_t> bytes = read_bytes(path);
   const std::uint64_t expected = entry.at("bytes").get<std::uint64_t>();
   if (bytes.size() < expected)
-    throw InputError("part '" + name + "' of model '" + dir.string() + "' is truncated (" + std::to_string(bytes.size()) +
-                     " of " + std::to_string(expected) + " bytes); rebuild the model");
+    throw InputError("part '" + name + "' of model '" + dir.string() + "' is truncated (" +
+                     std::to_string(bytes.size()) + " of " + std::to_string(expected) + " bytes); rebuild the model");
   if (bytes.size() > expected)
     throw InputError("part '" + name + "' of model '" + dir.string() + "' has " + std::to_string(bytes.size()) +
-                     " bytes where the manifest says " + std::to_string(expected) + "; it was altered: rebuild the model");
+                     " bytes where the manifest says " + std::to_string(expected) +
+                     "; it was altered: rebuild the model");
   if (hex64(fnv1a64(bytes.data(), bytes.size())) != entry.at("fnv1a64").get<std::string>())
     throw InputError("part '" + name + "' of model '" + dir.string() +
                      "' was altered or corrupted (checksum mismatch); rebuild the model");
@@ -189,8 +193,8 @@ std::vector<std::uint8_t> read_part(const fs::path& dir, const nlohmann::json& e
 }
 
 nlohmann::json stats_to_json(const DetailStats& s) {
-  return {{"level", s.level}, {"count", s.count}, {"energy", s.energy}, {"rms", s.rms}, {"max", s.max},
-          {"degenerate_frames", s.degenerate_frames}};
+  return {{"level", s.level}, {"count", s.count}, {"energy", s.energy},
+          {"rms", s.rms},     {"max", s.max},     {"degenerate_frames", s.degenerate_frames}};
 }
 
 // What a model may replace: a model folder (with its manifest) or an empty one.
@@ -256,11 +260,13 @@ void save_model(const std::string& folder, const ShapeModel& model, const Progre
   m["source"] = model.source_image.empty() && !model.source_label
                     ? nlohmann::json(nullptr)
                     : nlohmann::json{{"image", model.source_image},
-                                     {"label", model.source_label ? nlohmann::json(*model.source_label) : nlohmann::json(nullptr)}};
+                                     {"label", model.source_label ? nlohmann::json(*model.source_label)
+                                                                  : nlohmann::json(nullptr)}};
   if (model.source_component && !m["source"].is_null()) m["source"]["component"] = *model.source_component;
   if (model.physical_frame) {
     const PhysicalFrame& f = *model.physical_frame;
-    m["physical_frame"] = {{"units", "mm"}, {"size", f.size}, {"spacing", f.spacing}, {"origin", f.origin}, {"direction", f.direction}};
+    m["physical_frame"] = {
+        {"units", "mm"}, {"size", f.size}, {"spacing", f.spacing}, {"origin", f.origin}, {"direction", f.direction}};
   } else {
     m["physical_frame"] = nullptr;
   }
@@ -307,16 +313,19 @@ nlohmann::json read_model_manifest(const std::string& folder) {
   if (m.is_discarded() || !m.is_object())
     throw InputError("model.json of '" + folder + "' is not valid JSON; it is truncated or corrupt: rebuild the model");
   if (!m.contains("format") || m["format"] != kFormatName)
-    throw InputError("model.json of '" + folder + "' is not a mrsnake model manifest (no \"format\": \"mrsnake-model\")");
+    throw InputError("model.json of '" + folder +
+                     "' is not a mrsnake model manifest (no \"format\": \"mrsnake-model\")");
   if (!m.contains("format_version") || !m["format_version"].is_number_integer())
-    throw InputError("model.json of '" + folder + "' has no integer format_version; the file is corrupt: rebuild the model");
+    throw InputError("model.json of '" + folder +
+                     "' has no integer format_version; the file is corrupt: rebuild the model");
   const auto version = m["format_version"].get<std::int64_t>();
   if (version > kModelFormatVersion)
     throw InputError("model '" + folder + "' has format version " + std::to_string(version) +
                      ", newer than this mrsnake reads (" + std::to_string(kModelFormatVersion) +
                      "); upgrade mrsnake or rebuild the model");
   if (version < 1)
-    throw InputError("model '" + folder + "' has an invalid format version " + std::to_string(version) + "; rebuild the model");
+    throw InputError("model '" + folder + "' has an invalid format version " + std::to_string(version) +
+                     "; rebuild the model");
   if (!m.contains("manifest_fnv1a64") || !m["manifest_fnv1a64"].is_string() ||
       m["manifest_fnv1a64"].get<std::string>() != manifest_checksum(m))
     throw InputError("model.json of '" + folder + "' was altered (its checksum does not match); rebuild the model");
@@ -331,19 +340,21 @@ ShapeModel load_model(const std::string& folder, const LoadModelOptions& options
     ShapeModel model;
     std::vector<int> counts;
     const nlohmann::json& files = m.at("files");
-    decode_details(read_part(dir, files.at("details"), "base mesh and details"), "part 'details.bin' of " + where, model,
-                   counts);
+    decode_details(read_part(dir, files.at("details"), "base mesh and details"), "part 'details.bin' of " + where,
+                   model, counts);
     // The manifest and the binary part must agree.
     const int L = m.at("levels").get<int>();
     if (L != model.levels() || m.at("vertex_counts").get<std::vector<int>>() != counts ||
         m.at("wavelet").at("predict").get<std::string>() != to_string(model.wavelet.predict) ||
         m.at("wavelet").at("detail_frame").get<std::string>() != to_string(model.wavelet.frame))
-      throw InputError(where + ": model.json and details.bin disagree on the levels, counts or scheme; rebuild the model");
+      throw InputError(where +
+                       ": model.json and details.bin disagree on the levels, counts or scheme; rebuild the model");
     SubdivisionConnectivity conn;
     try {
       conn = model.connectivity();
     } catch (const TopologyError& e) {
-      throw InputError("part 'details.bin' of " + where + " holds an invalid base mesh (" + e.what() + "); rebuild the model");
+      throw InputError("part 'details.bin' of " + where + " holds an invalid base mesh (" + e.what() +
+                       "); rebuild the model");
     }
     if (conn.vertex_counts != counts)
       throw InputError("part 'details.bin' of " + where +
@@ -362,7 +373,8 @@ ShapeModel load_model(const std::string& folder, const LoadModelOptions& options
       model.level_positions.push_back(mesh.V);
     }
     for (const auto& [name, entry] : m.at("sections").items()) {
-      if (!valid_section_name(name)) throw InputError(where + ": model.json lists an invalid section name '" + name + "'");
+      if (!valid_section_name(name))
+        throw InputError(where + ": model.json lists an invalid section name '" + name + "'");
       model.sections[name] = read_part(dir, entry, "section '" + name + "'");
     }
     // Provenance and reports.
@@ -396,7 +408,8 @@ ShapeModel load_model(const std::string& folder, const LoadModelOptions& options
     }
     return model;
   } catch (const nlohmann::json::exception& e) {
-    throw InputError("model.json of '" + folder + "' has a missing or malformed field (" + e.what() + "); rebuild the model");
+    throw InputError("model.json of '" + folder + "' has a missing or malformed field (" + e.what() +
+                     "); rebuild the model");
   }
 }
 

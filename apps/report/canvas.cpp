@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 
-
 namespace mrsnake::reports {
 
 Canvas::Canvas(int width, int height, Rgb background)

@@ -38,7 +38,8 @@ void frame(std::ostringstream& svg, const std::string& title, const std::string&
       << escape_html(x_label) << "</text>"
       << "<text transform='translate(13," << (kTop + kHeight - kBottom) / 2 << ") rotate(-90)' text-anchor='middle'>"
       << escape_html(y_label) << "</text>"
-      << "<text x='" << kLeft << "' y='" << kHeight - kBottom + 14 << "' text-anchor='middle'>" << number(x0) << "</text>"
+      << "<text x='" << kLeft << "' y='" << kHeight - kBottom + 14 << "' text-anchor='middle'>" << number(x0)
+      << "</text>"
       << "<text x='" << kWidth - kRight << "' y='" << kHeight - kBottom + 14 << "' text-anchor='middle'>" << number(x1)
       << "</text>"
       << "<text x='" << kLeft - 4 << "' y='" << kHeight - kBottom << "' text-anchor='end'>" << number(y0) << "</text>"

@@ -148,14 +148,13 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
   settings.push_back({"levels L", std::to_string(L)});
   settings.push_back({"faces (finest)", std::to_string(result.connectivity.faces.back().rows())});
   settings.push_back({"base vertices n0", std::to_string(result.levels.front().positions.rows())});
-  for (const char* key : {"input", "relax", "density_exponent", "curvature_weight", "lloyd_iterations", "shape_iterations"})
+  for (const char* key :
+       {"input", "relax", "density_exponent", "curvature_weight", "lloyd_iterations", "shape_iterations"})
     if (r.is_object() && r.contains(key)) settings.push_back({key, setting(r[key])});
   if (result.parameterization.is_object())
     for (const auto& [key, value] : result.parameterization.items())
-      if (!value.is_structured())
-        settings.push_back({"parameterization " + key, setting(value)});
-  if (options.input)
-    settings.push_back({"input faces", std::to_string(options.input->num_faces())});
+      if (!value.is_structured()) settings.push_back({"parameterization " + key, setting(value)});
+  if (options.input) settings.push_back({"input faces", std::to_string(options.input->num_faces())});
   page.heading("Settings");
   page.table({"setting", "value"}, settings);
 
@@ -163,7 +162,8 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
   page.heading("Quality per level");
   page.paragraph(
       "The columns of the seed paper's Fig. 2: geometric error (RMS distance to the input, % of its bounding-box "
-      "diagonal), variance of the angles (deg²), smallest angle, variance of the edge lengths normalized by their mean, "
+      "diagonal), variance of the angles (deg²), smallest angle, variance of the edge lengths normalized by their "
+      "mean, "
       "and the shape factor Q (Frey–Borouchaki, 1 = equilateral; min and mean); plus the share of interior vertices "
       "of valence 6 and the Hausdorff distance." +
       std::string(unrelaxed ? " 'unrelaxed' is the same input and base split 1:4 without any relaxation "
@@ -173,27 +173,40 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
   bool distance_missing = false, distance_computed = false;
   int samples = options.distance_samples_per_face;
   if (samples <= 0)
-    samples = options.input ? std::clamp(static_cast<int>(100000 / std::max<Eigen::Index>(1, options.input->num_faces())), 0, 10)
-                            : 10;
+    samples = options.input
+                  ? std::clamp(static_cast<int>(100000 / std::max<Eigen::Index>(1, options.input->num_faces())), 0, 10)
+                  : 10;
   std::unique_ptr<SurfaceLocator> input_locator;
   const auto add_rows = [&](const RemeshResult& res, const std::string& variant) {
     for (int j = 0; j <= L; ++j) {
-      const auto [q, d] = level_figures(res, j, options.input, options.input_locator, input_locator, samples,
-                                           &distance_computed);
+      const auto [q, d] =
+          level_figures(res, j, options.input, options.input_locator, input_locator, samples, &distance_computed);
       if (d.is_null()) distance_missing = true;
       rows.push_back({std::to_string(j), variant, std::to_string(res.levels[j].positions.rows()),
-                      std::to_string(res.connectivity.faces[j].rows()), cell(d, "rms_pct", 3), cell(d, "hausdorff_pct", 3),
-                      cell(q, "angle_variance_deg2", 1), cell(q, "min_angle_deg", 2), cell(q, "edge_length_variance", 4),
-                      cell(q, "q_min", 3), cell(q, "q_mean", 3), cell(q, "pct_valence6_interior", 2),
-                      std::to_string(res.levels[j].flipped_triangles)});
+                      std::to_string(res.connectivity.faces[j].rows()), cell(d, "rms_pct", 3),
+                      cell(d, "hausdorff_pct", 3), cell(q, "angle_variance_deg2", 1), cell(q, "min_angle_deg", 2),
+                      cell(q, "edge_length_variance", 4), cell(q, "q_min", 3), cell(q, "q_mean", 3),
+                      cell(q, "pct_valence6_interior", 2), std::to_string(res.levels[j].flipped_triangles)});
     }
   };
   add_rows(result, unrelaxed ? "relaxed" : "");
   if (unrelaxed) add_rows(*unrelaxed, "unrelaxed");
   if (unrelaxed)  // side by side: sort by level, relaxed first
-    std::stable_sort(rows.begin(), rows.end(), [](const auto& a, const auto& b) { return std::stoi(a[0]) < std::stoi(b[0]); });
-  std::vector<std::string> header = {"level", "variant", "vertices", "faces", "RMS error %", "Hausdorff %", "angle variance (deg²)",
-              "min angle (°)", "edge length variance", "Q min", "Q mean", "valence 6 %", "flipped in D"};
+    std::stable_sort(rows.begin(), rows.end(),
+                     [](const auto& a, const auto& b) { return std::stoi(a[0]) < std::stoi(b[0]); });
+  std::vector<std::string> header = {"level",
+                                     "variant",
+                                     "vertices",
+                                     "faces",
+                                     "RMS error %",
+                                     "Hausdorff %",
+                                     "angle variance (deg²)",
+                                     "min angle (°)",
+                                     "edge length variance",
+                                     "Q min",
+                                     "Q mean",
+                                     "valence 6 %",
+                                     "flipped in D"};
   if (!unrelaxed) {  // one variant: no column for it
     header.erase(header.begin() + 1);
     for (auto& row : rows) row.erase(row.begin() + 1);
@@ -240,10 +253,11 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
 
   // The parametric domain coloured by the stretch.
   page.heading("Parametric domain");
-  page.paragraph("The finest level's mesh in the domain D (" + result.domain +
-                 "), each face coloured by its stretch A_3D / A_D (log10) between the finest level and its domain mesh: "
-                 "red regions of D are sampled densely. The Lloyd density is (stretch·w)^density_exponent, w the "
-                 "curvature sizing.");
+  page.paragraph(
+      "The finest level's mesh in the domain D (" + result.domain +
+      "), each face coloured by its stretch A_3D / A_D (log10) between the finest level and its domain mesh: "
+      "red regions of D are sampled densely. The Lloyd density is (stretch·w)^density_exponent, w the "
+      "curvature sizing.");
   if (can_render) {
     picture(page, "The domain picture", [&] {
       const std::vector<double> stretch = face_stretch(result, L);
@@ -265,8 +279,7 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
       const auto [lo, hi] = std::minmax_element(stretch.begin(), stretch.end());
       page.begin_figures();
       page.png(render_mesh_png(domain, ro), "domain of level " + std::to_string(L) + ", stretch from " + fixed(*lo, 3) +
-                                                " to " + fixed(*hi, 3) +
-                                                " (colours: 1st to 99th percentile)");
+                                                " to " + fixed(*hi, 3) + " (colours: 1st to 99th percentile)");
       if (result.domain == "sphere") {
         ro.azimuth += 180;  // the far side of the sphere
         page.png(render_mesh_png(domain, ro), "the far side");
@@ -287,8 +300,9 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
                "all triangle angles" + variant + " (60° = equilateral)");
     });
     picture(page, "The edge length histogram", [&] {
-      page.svg(svg_histogram(normalized_edge_lengths(mesh), 50, 0, 2.5, "Edge lengths" + variant, "length / mean length"),
-               "edge lengths" + variant + ", divided by their mean");
+      page.svg(
+          svg_histogram(normalized_edge_lengths(mesh), 50, 0, 2.5, "Edge lengths" + variant, "length / mean length"),
+          "edge lengths" + variant + ", divided by their mean");
     });
     page.end_figures();
   };

@@ -51,7 +51,6 @@ bool display_available(std::string* why) {
 namespace {
 
 std::vector<std::uint8_t> render_in_this_process(const TriMesh& mesh, const RenderOptions& options) {
-
   vtkNew<vtkRenderer> renderer;
   renderer->SetBackground(1, 1, 1);
   renderer->SetBackground2(0.82, 0.86, 0.92);
@@ -195,7 +194,8 @@ std::vector<std::uint8_t> render_mesh_png(const TriMesh& mesh, const RenderOptio
     throw Error("the 3D renderer stopped (signal " + std::to_string(WTERMSIG(status)) +
                 "): VTK could not open an OpenGL window on the display");
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || png.size() < 8)
-    throw Error("the 3D renderer failed (exit code " + std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")");
+    throw Error("the 3D renderer failed (exit code " + std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) +
+                ")");
   return png;
 }
 

@@ -57,7 +57,8 @@ std::vector<double> iterations(std::size_t n) {
 }  // namespace
 
 std::string segment_report_html(const SegmentPageInput& in) {
-  if (!in.image || !in.surface) throw std::invalid_argument("segment_report_html: the image and the surface are required");
+  if (!in.image || !in.surface)
+    throw std::invalid_argument("segment_report_html: the image and the surface are required");
   HtmlPage page(in.title);
   const nlohmann::json& r = in.report;
 
@@ -81,8 +82,10 @@ std::string segment_report_html(const SegmentPageInput& in) {
   page.heading("Slices");
   std::vector<LabelContour> label_contours;
   if (in.truth) label_contours.push_back({in.truth, in.truth_label, {64, 220, 64}, "truth"});
-  page.paragraph(std::string("Three orthogonal slices through the centre of the final surface: the final contour in red") +
-                 (in.truth ? ", the truth's outline in green (hidden under the red where the two agree)." : ". (No --truth was given.)"));
+  page.paragraph(
+      std::string("Three orthogonal slices through the centre of the final surface: the final contour in red") +
+      (in.truth ? ", the truth's outline in green (hidden under the red where the two agree)."
+                : ". (No --truth was given.)"));
   page.begin_figures();
   const char* axis_names[] = {"sagittal (x)", "coronal (y)", "axial (z)"};
   std::array<double, 3> centre{};
@@ -129,8 +132,9 @@ std::string segment_report_html(const SegmentPageInput& in) {
   if (in.convergence.empty()) {
     page.note("No convergence history was recorded.");
   } else {
-    page.paragraph("Energy (mean matched cost plus the internal term) and the mean |matched offset| along the normals "
-                   "at each iteration of each level.");
+    page.paragraph(
+        "Energy (mean matched cost plus the internal term) and the mean |matched offset| along the normals "
+        "at each iteration of each level.");
     page.begin_figures();
     for (const SnakeConvergence& c : in.convergence) {
       if (!c.deformed) {
@@ -142,8 +146,10 @@ std::string segment_report_html(const SegmentPageInput& in) {
       picture(page, "The convergence plot of level " + std::to_string(c.level), [&] {
         std::vector<Series> series;
         if (!c.energy.empty()) series.push_back({"energy", iterations(c.energy.size()), c.energy});
-        if (!c.external_energy.empty()) series.push_back({"external", iterations(c.external_energy.size()), c.external_energy});
-        if (!c.internal_energy.empty()) series.push_back({"internal", iterations(c.internal_energy.size()), c.internal_energy});
+        if (!c.external_energy.empty())
+          series.push_back({"external", iterations(c.external_energy.size()), c.external_energy});
+        if (!c.internal_energy.empty())
+          series.push_back({"internal", iterations(c.internal_energy.size()), c.internal_energy});
         if (series.empty()) throw std::runtime_error("no iterations were recorded");
         page.svg(svg_line_plot(series, "Level " + std::to_string(c.level) + " energy", "iteration", "energy"),
                  "level " + std::to_string(c.level) + ": " + std::to_string(c.energy.size()) + " iterations");
@@ -153,7 +159,8 @@ std::string segment_report_html(const SegmentPageInput& in) {
       std::vector<Series> series;
       for (const SnakeConvergence& c : in.convergence)
         if (!c.mean_abs_offset_mm.empty())
-          series.push_back({"level " + std::to_string(c.level), iterations(c.mean_abs_offset_mm.size()), c.mean_abs_offset_mm});
+          series.push_back(
+              {"level " + std::to_string(c.level), iterations(c.mean_abs_offset_mm.size()), c.mean_abs_offset_mm});
       if (series.empty()) throw std::runtime_error("no offsets were recorded");
       page.svg(svg_line_plot(series, "Mean |matched offset|", "iteration", "mm"), "mean |matched offset| per level");
     });
@@ -162,12 +169,22 @@ std::string segment_report_html(const SegmentPageInput& in) {
 
   // Levels and timings.
   if (r.is_object() && r.contains("levels") && r["levels"].is_array() && !r["levels"].empty()) {
-    const std::vector<std::pair<const char*, const char*>> columns = {
-        {"level", "level"}, {"vertices", "vertices"}, {"pyramid_level", "pyramid level"}, {"voxel_mm", "voxel (mm)"},
-        {"search_range_mm", "search range (mm)"}, {"iterations", "iterations"}, {"converged", "converged"},
-        {"energy", "energy"}, {"mean_abs_offset_mm", "mean |offset| (mm)"}, {"rejected_steps", "rejected steps"},
-        {"rolled_back_vertices", "rolled back"}, {"deformed", "deformed"}, {"offset_smoothing", "offset averaging passes"},
-        {"flipped_faces", "flipped faces"}, {"synthesis_seconds", "synthesis (s)"}, {"seconds", "seconds"}};
+    const std::vector<std::pair<const char*, const char*>> columns = {{"level", "level"},
+                                                                      {"vertices", "vertices"},
+                                                                      {"pyramid_level", "pyramid level"},
+                                                                      {"voxel_mm", "voxel (mm)"},
+                                                                      {"search_range_mm", "search range (mm)"},
+                                                                      {"iterations", "iterations"},
+                                                                      {"converged", "converged"},
+                                                                      {"energy", "energy"},
+                                                                      {"mean_abs_offset_mm", "mean |offset| (mm)"},
+                                                                      {"rejected_steps", "rejected steps"},
+                                                                      {"rolled_back_vertices", "rolled back"},
+                                                                      {"deformed", "deformed"},
+                                                                      {"offset_smoothing", "offset averaging passes"},
+                                                                      {"flipped_faces", "flipped faces"},
+                                                                      {"synthesis_seconds", "synthesis (s)"},
+                                                                      {"seconds", "seconds"}};
     std::vector<std::string> header;
     for (const auto& c : columns) header.push_back(c.second);
     std::vector<std::vector<std::string>> rows;

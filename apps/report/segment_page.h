@@ -20,8 +20,8 @@ namespace mrsnake::reports {
 /// The convergence history of one level of the snake: one entry per iteration.
 struct SnakeConvergence {
   int level = 0;
-  std::vector<double> energy;              ///< external + internal
-  std::vector<double> external_energy;     ///< mean matched cost
+  std::vector<double> energy;           ///< external + internal
+  std::vector<double> external_energy;  ///< mean matched cost
   std::vector<double> internal_energy;
   std::vector<double> mean_abs_offset_mm;  ///< mean |matched offset|, mm
   bool deformed = true;                    ///< false: finer than the image, only synthesized (no iterations)
@@ -29,10 +29,10 @@ struct SnakeConvergence {
 
 struct SegmentPageInput {
   std::string title = "mrsnake segment";
-  const Volume* image = nullptr;         ///< the segmented volume (required)
-  const TriMesh* surface = nullptr;      ///< the final surface (required)
-  const Volume* truth = nullptr;         ///< optional truth labels on the image's grid
-  float truth_label = 1;                 ///< the object's value in *truth
+  const Volume* image = nullptr;              ///< the segmented volume (required)
+  const TriMesh* surface = nullptr;           ///< the final surface (required)
+  const Volume* truth = nullptr;              ///< optional truth labels on the image's grid
+  float truth_label = 1;                      ///< the object's value in *truth
   std::vector<SnakeConvergence> convergence;  ///< per level; empty: the plots say so
   /// segment_report's JSON (levels, scores, stage_seconds, initial_pose, ...), shown as tables.
   nlohmann::json report;

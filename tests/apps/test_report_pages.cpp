@@ -67,8 +67,12 @@ const Remeshed& remeshed() {
   return r;
 }
 
-const char* kSections[] = {"<h2>Settings</h2>", "<h2>Quality per level</h2>", "<h2>Levels</h2>",
-                           "<h2>Parametric domain</h2>", "<h2>Angles and edge lengths (level 2)</h2>", "<h2>Timings</h2>"};
+const char* kSections[] = {"<h2>Settings</h2>",
+                           "<h2>Quality per level</h2>",
+                           "<h2>Levels</h2>",
+                           "<h2>Parametric domain</h2>",
+                           "<h2>Angles and edge lengths (level 2)</h2>",
+                           "<h2>Timings</h2>"};
 
 }  // namespace
 
@@ -148,7 +152,7 @@ TEST(RemeshPage, RemeshCliWritesThePageWithoutADisplay) {
   const fs::path dir = test::scratch_dir("remesh-page");
   write_mesh((dir / "sphere.vtp").string(), icosphere(3, 10.0));
   const auto r = run_without_display("remesh " + (dir / "sphere.vtp").string() + " -o " + (dir / "out").string() +
-                                         " --levels 2 --base-vertices 24 --compare-unrelaxed");
+                                     " --levels 2 --base-vertices 24 --compare-unrelaxed");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string html = read_text(dir / "out" / "report.html");
   for (const char* section : kSections) EXPECT_EQ(count(html, section), 1) << section;
@@ -164,8 +168,8 @@ TEST(RemeshPage, BuildModelWritesThePageInsideTheModel) {
   auto r = test::run_mrsnake("synth --shape ellipsoid --size 32 --noise none -o " + (dir / "case").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const fs::path model = dir / "m.model";
-  r = test::run_mrsnake("build-model --labels " + (dir / "case" / "truth.nii.gz").string() + " --label 1 --faces 2048 -o " +
-                        model.string());
+  r = test::run_mrsnake("build-model --labels " + (dir / "case" / "truth.nii.gz").string() +
+                        " --label 1 --faces 2048 -o " + model.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   ASSERT_TRUE(fs::exists(model / "report.html"));
   const std::string html = read_text(model / "report.html");
@@ -221,8 +225,10 @@ struct SegmentCase {
   }
 };
 
-const char* kSegmentSections[] = {"<h2>Summary</h2>", "<h2>Scores against the truth</h2>", "<h2>Slices</h2>",
-                                  "<h2>Surface</h2>", "<h2>Convergence</h2>", "<h2>Levels</h2>", "<h2>Timings</h2>"};
+const char* kSegmentSections[] = {"<h2>Summary</h2>",     "<h2>Scores against the truth</h2>",
+                                  "<h2>Slices</h2>",      "<h2>Surface</h2>",
+                                  "<h2>Convergence</h2>", "<h2>Levels</h2>",
+                                  "<h2>Timings</h2>"};
 
 }  // namespace
 

@@ -112,7 +112,8 @@ TEST_F(Robustness, TruncatedImage) {
 
 TEST_F(Robustness, TwoDimensionalAndFourDimensionalImages) {
   write_nifti(path("flat.nii"), {32, 32});
-  expect_one_line_error(run_mrsnake("mc --labels " + path("flat.nii") + " --label 1 -o " + path("f.vtp")), 3, "2D image");
+  expect_one_line_error(run_mrsnake("mc --labels " + path("flat.nii") + " --label 1 -o " + path("f.vtp")), 3,
+                        "2D image");
   write_nifti(path("series.nii"), {16, 16, 16, 3});
   expect_one_line_error(run_mrsnake("mc --labels " + path("series.nii") + " --label 1 -o " + path("s.vtp")), 3,
                         "4D image");
@@ -126,8 +127,9 @@ TEST_F(Robustness, EmptyLabelVolume) {
   empty.size = {20, 20, 20};
   empty.data.assign(empty.num_voxels(), 0.f);
   mrsnake::write_volume(path("empty.nii.gz"), empty, mrsnake::VoxelType::uint8);
-  expect_one_line_error(run_mrsnake("build-model --labels " + path("empty.nii.gz") + " --label 1 -o " + path("e.model")),
-                        3, "not present");
+  expect_one_line_error(
+      run_mrsnake("build-model --labels " + path("empty.nii.gz") + " --label 1 -o " + path("e.model")), 3,
+      "not present");
   EXPECT_FALSE(fs::exists(path("e.model")));
 }
 
@@ -139,15 +141,18 @@ TEST_F(Robustness, MetaImageWithItsVoxelsInAnotherFile) {
   for (int k = 0; k < 20; ++k)
     for (int j = 0; j < 20; ++j)
       for (int i = 0; i < 20; ++i)
-        if ((i - 9.5) * (i - 9.5) + (j - 9.5) * (j - 9.5) + (k - 9.5) * (k - 9.5) <= 36) voxels[i + 20 * (j + 20 * k)] = 1;
+        if ((i - 9.5) * (i - 9.5) + (j - 9.5) * (j - 9.5) + (k - 9.5) * (k - 9.5) <= 36)
+          voxels[i + 20 * (j + 20 * k)] = 1;
   const auto write_header = [&](const std::string& name, const std::string& data_file, std::size_t compressed_bytes) {
     std::ofstream h(path(name));
     h << "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\n";
     if (compressed_bytes > 0) h << "CompressedData = True\nCompressedDataSize = " << compressed_bytes << "\n";
-    h << "ElementSpacing = 1 1 1.5\nDimSize = 20 20 20\nElementType = MET_UCHAR\nElementDataFile = " << data_file << "\n";
+    h << "ElementSpacing = 1 1 1.5\nDimSize = 20 20 20\nElementType = MET_UCHAR\nElementDataFile = " << data_file
+      << "\n";
   };
   const auto write_bytes = [&](const std::string& name, const unsigned char* data, std::size_t n) {
-    std::ofstream(path(name), std::ios::binary).write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(n));
+    std::ofstream(path(name), std::ios::binary)
+        .write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(n));
   };
   write_bytes("ball.raw", voxels.data(), voxels.size());
   write_header("ball.mhd", "ball.raw", 0);
@@ -181,7 +186,8 @@ TEST_F(Robustness, MetaImageWithItsVoxelsInAnotherFile) {
   // The same for NRRD: a detached header (.nhdr) naming its raw file, and gzip encoding.
   const auto write_nhdr = [&](const std::string& name, const std::string& data_file) {
     std::ofstream(path(name)) << "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 20 20 20\nspacings: 1 1 1.5\n"
-                                 "encoding: raw\ndata file: " << data_file << "\n\n";
+                                 "encoding: raw\ndata file: "
+                              << data_file << "\n\n";
   };
   write_nhdr("ball.nhdr", "ball.raw");
   const auto nhdr = run_mrsnake("-q mc --labels " + path("ball.nhdr") + " --label 1 -o " + path("nhdr.vtp"));
@@ -209,8 +215,8 @@ TEST_F(Robustness, NanAndInfVoxelsAreIgnored) {
   for (std::size_t i = 0; i < image.data.size(); i += 97) image.data[i] = std::numeric_limits<float>::quiet_NaN();
   for (std::size_t i = 13; i < image.data.size(); i += 101) image.data[i] = std::numeric_limits<float>::infinity();
   mrsnake::write_volume(path("nan.nii.gz"), image, mrsnake::VoxelType::float32);
-  const auto r = run_mrsnake("-q segment --image " + path("nan.nii.gz") + " --model " + path("ellipsoid.model") + " -o " +
-                             path("seg-nan") + " --truth " + path("tgt/truth.nii.gz") + " --json");
+  const auto r = run_mrsnake("-q segment --image " + path("nan.nii.gz") + " --model " + path("ellipsoid.model") +
+                             " -o " + path("seg-nan") + " --truth " + path("tgt/truth.nii.gz") + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto report = nlohmann::json::parse(r.output);
   EXPECT_GE(report["scores"]["dice"].get<double>(), 0.9) << "1% of the voxels are NaN or Inf";
@@ -221,8 +227,9 @@ TEST_F(Robustness, ExtremeAnisotropy) {
   const auto s = run_mrsnake("-q synth --shape ellipsoid --size 96,96,12 --spacing 0.4,0.4,5 --snr 6 --seed 9 -o " +
                              path("aniso"));
   ASSERT_EQ(s.exit_code, 0) << s.output;
-  const auto r = run_mrsnake("-q segment --image " + path("aniso/image.nii.gz") + " --model " + path("ellipsoid.model") +
-                             " -o " + path("seg-aniso") + " --truth " + path("aniso/truth.nii.gz") + " --json");
+  const auto r =
+      run_mrsnake("-q segment --image " + path("aniso/image.nii.gz") + " --model " + path("ellipsoid.model") + " -o " +
+                  path("seg-aniso") + " --truth " + path("aniso/truth.nii.gz") + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto report = nlohmann::json::parse(r.output);
   EXPECT_EQ(report["self_intersections"], 0);
@@ -317,9 +324,9 @@ TEST_F(Robustness, BatchGoesOnPastABadImageAndSummarizesEveryImage) {
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
 
   // Two worker processes: the same rows (in the order given) and the same labels.
-  const auto two = run_mrsnake("-q segment-batch --jobs 2 --model " + path("ellipsoid.model") + " -o " +
-                               path("batch2") + " " + path("tgt/image.nii.gz") + " " + path("bad.nii.gz") + " --list " +
-                               path("list.txt"));
+  const auto two =
+      run_mrsnake("-q segment-batch --jobs 2 --model " + path("ellipsoid.model") + " -o " + path("batch2") + " " +
+                  path("tgt/image.nii.gz") + " " + path("bad.nii.gz") + " --list " + path("list.txt"));
   EXPECT_EQ(two.exit_code, 6) << two.output;
   const auto summary2 = nlohmann::json::parse(mrsnake::test::read_all(fs::path(path("batch2")) / "batch.json"));
   ASSERT_EQ(summary2["cases"].size(), 3u);
@@ -341,7 +348,7 @@ TEST_F(Robustness, BatchNamesAreDistinctAndNeverReplaceOtherData) {
   const fs::path in = *dir_ / "names";
   fs::create_directories(in / "d");
   fs::create_directories(in / ".cache");
-  const std::vector<std::string> files{"x.nii.gz",        "d/x_2.nii.gz",    "batch.json.nii.gz", "..nii.gz",
+  const std::vector<std::string> files{"x.nii.gz",       "d/x_2.nii.gz",    "batch.json.nii.gz", "..nii.gz",
                                        "bad\xff.nii.gz", "precious.nii.gz", ".cache/x_2.nii.gz"};
   for (const std::string& f : files) fs::copy_file(path("tgt/image.nii.gz"), in / f);
   const fs::path out = *dir_ / "names-out";
@@ -362,7 +369,8 @@ TEST_F(Robustness, BatchNamesAreDistinctAndNeverReplaceOtherData) {
     EXPECT_TRUE(name != "batch.json" && name != "batch.csv") << name;
     if (name == "precious") {
       EXPECT_EQ(c["status"], "failed");
-      EXPECT_NE(c["error"].get<std::string>().find("exists and is not an output of mrsnake segment"), std::string::npos);
+      EXPECT_NE(c["error"].get<std::string>().find("exists and is not an output of mrsnake segment"),
+                std::string::npos);
     } else {
       EXPECT_EQ(c["status"], "ok") << name << ": " << c.dump();
     }
@@ -380,11 +388,12 @@ TEST_F(Robustness, BatchNamesAreDistinctAndNeverReplaceOtherData) {
             4);
   fs::remove(out / "precious" / "report.json");
   // Nor does remesh replace other data.
-  expect_one_line_error(run_mrsnake("remesh " + path("ref/truth.vtp") + " --faces 512 -o " + (out / "precious").string()),
-                        4, "exists and is not an output of mrsnake remesh");
+  expect_one_line_error(
+      run_mrsnake("remesh " + path("ref/truth.vtp") + " --faces 512 -o " + (out / "precious").string()), 4,
+      "exists and is not an output of mrsnake remesh");
   // The single command refuses such a folder too, and replaces an earlier result.
-  const auto single = run_mrsnake("segment --image " + path("tgt/image.nii.gz") + " --model " + path("ellipsoid.model") +
-                                  " -o " + (out / "precious").string());
+  const auto single = run_mrsnake("segment --image " + path("tgt/image.nii.gz") + " --model " +
+                                  path("ellipsoid.model") + " -o " + (out / "precious").string());
   expect_one_line_error(single, 4, "exists and is not an output of mrsnake segment");
   EXPECT_TRUE(fs::exists(out / "precious" / "notes.txt"));
   EXPECT_EQ(run_mrsnake("-q segment --image " + path("tgt/image.nii.gz") + " --model " + path("ellipsoid.model") +
@@ -451,9 +460,8 @@ TEST(CommandLine, NonFiniteNumbersAreUsageErrors) {
   // CLI11's ranges let nan through (every comparison with it is false); every FLOAT option of
   // every command must refuse nan and inf with a one-line usage error (exit 2) naming the option.
   const std::string out = mrsnake::test::scratch_dir("non-finite").string();
-  for (const std::string& args :
-       {"synth -o " + out + "/s --snr inf", "synth -o " + out + "/s --blur -inf",
-        "build-model --labels l.nii.gz --label 1 -o " + out + "/m --mc-spacing nan"}) {
+  for (const std::string& args : {"synth -o " + out + "/s --snr inf", "synth -o " + out + "/s --blur -inf",
+                                  "build-model --labels l.nii.gz --label 1 -o " + out + "/m --mc-spacing nan"}) {
     const auto r = run_mrsnake(args);
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.output;
     EXPECT_NE(r.output.find("needs a finite number"), std::string::npos) << args << "\n" << r.output;

@@ -71,7 +71,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     manifest["files"]["details"]["fnv1a64"] = hex64(fnv1a64(details.data(), details.size()));
     manifest.erase("manifest_fnv1a64");
     const std::string compact = manifest.dump();
-    manifest["manifest_fnv1a64"] = hex64(fnv1a64(reinterpret_cast<const std::uint8_t*>(compact.data()), compact.size()));
+    manifest["manifest_fnv1a64"] =
+        hex64(fnv1a64(reinterpret_cast<const std::uint8_t*>(compact.data()), compact.size()));
     std::ofstream(work / "model.json", std::ios::trunc) << manifest.dump(2);
   }
   try {

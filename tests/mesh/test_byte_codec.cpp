@@ -15,11 +15,11 @@ TEST(ByteCodec, WritesLittleEndianBytes) {
   ByteWriter w({'M', 'G'});
   w.put<std::uint32_t>(0x01020304u);
   w.put<std::int32_t>(-2);
-  w.put<double>(1.0);  // IEEE-754: 0x3FF0000000000000
+  w.put<double>(1.0);   // IEEE-754: 0x3FF0000000000000
   w.put<float>(-2.0f);  // 0xC0000000
   w.put<std::uint8_t>(7);
-  const std::vector<std::uint8_t> expected = {'M',  'G',  4,    3,    2, 1, 0xFE, 0xFF, 0xFF, 0xFF, 0, 0, 0, 0,
-                                              0,    0,    0xF0, 0x3F, 0, 0, 0,    0xC0, 7};
+  const std::vector<std::uint8_t> expected = {'M', 'G', 4, 3, 2,    1,    0xFE, 0xFF, 0xFF, 0xFF, 0, 0,
+                                              0,   0,   0, 0, 0xF0, 0x3F, 0,    0,    0,    0xC0, 7};
   EXPECT_EQ(w.bytes(), expected);
 }
 

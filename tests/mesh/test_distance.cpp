@@ -123,14 +123,20 @@ TEST(SurfaceDistance, PrebuiltReferenceLocatorGivesTheSameNumbers) {
 TEST(ParallelRanges, CoversEveryIndexOnceAndRethrows) {
   for (std::size_t n : {0u, 1u, 7u, 1000u, 100003u}) {
     std::vector<std::atomic<int>> hits(n);
-    parallel_ranges(n, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) ++hits[i];
-    }, 16);
+    parallel_ranges(
+        n,
+        [&](std::size_t begin, std::size_t end) {
+          for (std::size_t i = begin; i < end; ++i) ++hits[i];
+        },
+        16);
     for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(hits[i].load(), 1) << "n " << n << " index " << i;
   }
-  EXPECT_THROW(parallel_ranges(100000, [](std::size_t, std::size_t end) {
-                 if (end == 100000) throw std::runtime_error("the last range's worker");
-               }, 16),
+  EXPECT_THROW(parallel_ranges(
+                   100000,
+                   [](std::size_t, std::size_t end) {
+                     if (end == 100000) throw std::runtime_error("the last range's worker");
+                   },
+                   16),
                std::runtime_error);
 }
 
@@ -157,7 +163,15 @@ TEST(ParallelRanges, RunBothRunsBothAndRethrowsAFirst) {
   EXPECT_EQ(ran.load(), 2);
   ran = 0;
   try {
-    run_both_in_parallel([&] { ++ran; throw std::runtime_error("a"); }, [&] { ++ran; throw std::logic_error("b"); });
+    run_both_in_parallel(
+        [&] {
+          ++ran;
+          throw std::runtime_error("a");
+        },
+        [&] {
+          ++ran;
+          throw std::logic_error("b");
+        });
     ADD_FAILURE() << "nothing thrown";
   } catch (const std::runtime_error& e) {
     EXPECT_STREQ(e.what(), "a");
@@ -220,8 +234,8 @@ TEST(SurfaceDistance, DeterministicFromTheSeedAndSensitiveToAFarVertex) {
   EXPECT_THROW(surface_distance(TriMesh{}, a), InputError);
 
   const nlohmann::json j = d1;
-  for (const char* key : {"mean_mm", "rms_mm", "hausdorff_mm", "mean_pct", "rms_pct", "hausdorff_pct",
-                          "reference_diagonal_mm"})
+  for (const char* key :
+       {"mean_mm", "rms_mm", "hausdorff_mm", "mean_pct", "rms_pct", "hausdorff_pct", "reference_diagonal_mm"})
     EXPECT_TRUE(j.contains(key)) << key;
 }
 

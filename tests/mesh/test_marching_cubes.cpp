@@ -78,7 +78,8 @@ TEST(MarchingCubes, ObliqueAnisotropicGridGivesThePhysicalPlace) {
   g.origin = {-12.0, 30.0, 5.5};
   // A rotation of 30° about z then 20° about x: an oblique, proper direction matrix.
   const Eigen::Matrix3d R =
-      (Eigen::AngleAxisd(0.35, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(0.52, Eigen::Vector3d::UnitZ())).toRotationMatrix();
+      (Eigen::AngleAxisd(0.35, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(0.52, Eigen::Vector3d::UnitZ()))
+          .toRotationMatrix();
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) g.direction[3 * r + c] = R(r, c);
   // The ball's centre: the physical point of the grid's middle.
@@ -109,7 +110,8 @@ TEST(MarchingCubes, ResampledOccupancyGivesTheBallWithFewerFaces) {
   g.spacing = {0.6, 0.6, 1.3};
   g.origin = {4.0, -20.0, 7.0};
   const Eigen::Matrix3d R =
-      (Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(-0.6, Eigen::Vector3d::UnitZ())).toRotationMatrix();
+      (Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(-0.6, Eigen::Vector3d::UnitZ()))
+          .toRotationMatrix();
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) g.direction[3 * r + c] = (c == 2 ? -1.0 : 1.0) * R(r, c);
   const auto mid = g.index_to_physical(27.5, 27.5, 13.5);
@@ -205,7 +207,8 @@ TEST(MarchingCubes, OccupancyIsTheMaskSmoothedBySigmaAndCrossesOneHalfAtTheVoxel
     std::vector<double> found;
     for (std::size_t i = 0; i + 1 < field.size[d]; ++i) {
       const double a = value(d, i), b = value(d, i + 1);
-      if ((a - 0.5) * (b - 0.5) < 0) found.push_back(field.origin[d] + 1.3 * (static_cast<double>(i) + (0.5 - a) / (b - a)));
+      if ((a - 0.5) * (b - 0.5) < 0)
+        found.push_back(field.origin[d] + 1.3 * (static_cast<double>(i) + (0.5 - a) / (b - a)));
     }
     return found;
   };
@@ -213,7 +216,9 @@ TEST(MarchingCubes, OccupancyIsTheMaskSmoothedBySigmaAndCrossesOneHalfAtTheVoxel
   ASSERT_EQ(z.size(), 2u);
   EXPECT_NEAR(z[0], 1.3 * 9.5, 1e-4);
   EXPECT_NEAR(z[1], 1.3 * 25.5, 1e-4);
-  const auto z_index = [&](double k) { return static_cast<std::size_t>(std::lround((1.3 * k - field.origin[2]) / 1.3)); };
+  const auto z_index = [&](double k) {
+    return static_cast<std::size_t>(std::lround((1.3 * k - field.origin[2]) / 1.3));
+  };
   EXPECT_NEAR(value(2, z_index(10)), 1 - w, 1e-5);
   EXPECT_NEAR(value(2, z_index(9)), w, 1e-5);
   EXPECT_NEAR(value(2, z_index(17)), 1.0, 1e-5);
@@ -298,7 +303,8 @@ TEST(McCommand, ComponentExtractsOnePartOfTheLabel) {
   const auto centre_x = [](const TriMesh& m) { return m.V.col(0).mean(); };
   for (const int part : {1, 2}) {
     const std::string out = (dir / ("part" + std::to_string(part) + ".vtp")).string();
-    const auto r = test::run_mrsnake("mc --labels " + img + " --label 4 --component " + std::to_string(part) + " -o " + out);
+    const auto r =
+        test::run_mrsnake("mc --labels " + img + " --label 4 --component " + std::to_string(part) + " -o " + out);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_EQ(r.output.find("connected surfaces"), std::string::npos) << r.output;  // nothing dropped
     EXPECT_NEAR(centre_x(read_mesh(out)), part == 1 ? 8.0 : 24.0, 0.5);
@@ -354,7 +360,7 @@ TEST(LabelParts, KeepsThePartOfTheRankAskedAndLeavesOtherLabels) {
   const Volume c = voxelized_ball(grid(40, {1, 1, 1}), {10, 30, 30}, 4.0, 2, other);
   for (std::size_t i = 0; i < labels.num_voxels(); ++i) labels.data[i] += b.data[i] + c.data[i];
   ASSERT_EQ(labels.at(29, 28, 13), 7.f);  // on the top layer of the smaller ball
-  labels.at(30, 28, 14) = 7.f;           // meets (29, 28, 13) along an edge only
+  labels.at(30, 28, 14) = 7.f;            // meets (29, 28, 13) along an edge only
   const auto count = [](const Volume& v, float value) {
     return static_cast<std::size_t>(std::count(v.data.begin(), v.data.end(), value));
   };
@@ -374,8 +380,9 @@ TEST(LabelParts, KeepsThePartOfTheRankAskedAndLeavesOtherLabels) {
     keep_label_part(labels, 7, 4);
     ADD_FAILURE() << "a fourth part of three was accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("label 7 has 3 connected parts, so there is no part 4; give --component 1 to 3"),
-              std::string::npos)
+    EXPECT_NE(
+        std::string(e.what()).find("label 7 has 3 connected parts, so there is no part 4; give --component 1 to 3"),
+        std::string::npos)
         << e.what();
   }
   EXPECT_THROW(keep_label_part(labels, 9, 1), InputError);

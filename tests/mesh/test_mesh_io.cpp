@@ -110,25 +110,28 @@ TEST(MeshIO, MalformedPlyIsRefusedNotCrashed) {
     std::ofstream((dir / name).string(), std::ios::binary) << text;
     return (dir / name).string();
   };
-  const std::string header = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
-                             "property float z\nelement face 5\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 5\nproperty list uchar int vertex_indices\nend_header\n";
   const std::string vertices = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n";
   EXPECT_THROW(read_mesh(write("fuzz.ply", header + vertices + "2 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n")), InputError);
   EXPECT_THROW(read_mesh(write("short.ply", header + vertices + "3 0 2 1\n3 0 1 3\n")), InputError);
   EXPECT_THROW(read_mesh(write("index.ply", header + vertices + "3 0 2 9\n3 0 1 3\n3 0 3 2\n3 1 2 3\n3 1 2 3\n")),
                InputError);
   EXPECT_THROW(read_mesh(write("noheader.ply", "ply\nformat ascii 1.0\n")), InputError);
-  EXPECT_THROW(read_mesh(write("binary.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 2\n"
-                                             "property float x\nproperty float y\nproperty float z\nend_header\n\x01\x02")),
+  EXPECT_THROW(read_mesh(write("binary.ply",
+                               "ply\nformat binary_little_endian 1.0\nelement vertex 2\n"
+                               "property float x\nproperty float y\nproperty float z\nend_header\n\x01\x02")),
                InputError);
 }
 
 TEST(MeshIO, StlAsciiMergesCornersAndDamagedBinaryIsRefused) {
   const auto dir = test::scratch_dir("stl");
   const std::string ascii = (dir / "a.stl").string();
-  std::ofstream(ascii) << "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
-                          "endloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 1 1 0\nvertex 0 1 0\n"
-                          "endloop\nendfacet\nendsolid t\n";
+  std::ofstream(ascii)
+      << "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+         "endloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 1 1 0\nvertex 0 1 0\n"
+         "endloop\nendfacet\nendsolid t\n";
   const TriMesh m = read_mesh(ascii);
   EXPECT_EQ(m.num_vertices(), 4);
   EXPECT_EQ(m.num_faces(), 2);
@@ -146,8 +149,9 @@ TEST(MeshIO, LegacyVtkWithStrayBytesIsRefused) {
   // Fuzzing found that VTK 9.1's legacy reader dereferences null on a NUL in an ASCII file.
   const auto dir = test::scratch_dir("vtk-bad");
   const std::string path = (dir / "nul.vtk").string();
-  const std::string text = "# vtk DataFile Version 3.0\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n"
-                           "0 0 0 1 0 0 0 1 0\nPOLYGONS 1 4\n3 0";
+  const std::string text =
+      "# vtk DataFile Version 3.0\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n"
+      "0 0 0 1 0 0 0 1 0\nPOLYGONS 1 4\n3 0";
   std::ofstream(path, std::ios::binary) << text << '\0' << " 1 2\n";
   EXPECT_THROW(read_mesh(path), InputError);
   const std::string star = (dir / "star.vtk").string();  // printable but malformed

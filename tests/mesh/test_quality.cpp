@@ -164,10 +164,10 @@ TEST(Quality, StripBoundaryValenceFour) {
 
 TEST(Quality, JsonKeysAreTheFieldNames) {
   const nlohmann::json j = mesh_quality(icosahedron());
-  for (const char* key : {"vertices", "faces", "min_angle_deg", "mean_min_angle_deg", "pct_min_angle_below_30",
-                          "angle_deviation_deg", "angle_variance_deg2", "q_min", "q_mean", "radius_ratio_min",
-                          "radius_ratio_mean", "edge_length_mean", "edge_length_cv", "edge_length_variance",
-                          "pct_valence6_interior", "pct_valence4_boundary", "area_cv"})
+  for (const char* key :
+       {"vertices", "faces", "min_angle_deg", "mean_min_angle_deg", "pct_min_angle_below_30", "angle_deviation_deg",
+        "angle_variance_deg2", "q_min", "q_mean", "radius_ratio_min", "radius_ratio_mean", "edge_length_mean",
+        "edge_length_cv", "edge_length_variance", "pct_valence6_interior", "pct_valence4_boundary", "area_cv"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j.size(), 17u);
   EXPECT_EQ(j["faces"].get<int>(), 20);

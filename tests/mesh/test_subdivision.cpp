@@ -36,8 +36,7 @@ TEST(Subdivision, LevelsArePrefixesAndParentsAreEdgesOfTheCoarserLevel) {
       EXPECT_EQ(conn.level_of_vertex(v), j + 1);
     }
     // Each child face's corners are either the parent's corners or its edge midpoints.
-    for (int f = 0; f < conn.faces[j].rows(); ++f)
-      EXPECT_EQ(conn.faces[j + 1](4 * f, 0), conn.faces[j](f, 0));
+    for (int f = 0; f < conn.faces[j].rows(); ++f) EXPECT_EQ(conn.faces[j + 1](4 * f, 0), conn.faces[j](f, 0));
   }
   EXPECT_EQ(conn.level_of_vertex(0), 0);
   EXPECT_EQ(conn.level_of_vertex(11), 0);

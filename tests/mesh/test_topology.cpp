@@ -109,18 +109,16 @@ TEST_P(SharedMeshes, TopologyMatchesTheDataReadme) {
   EXPECT_TRUE(r.is_manifold());
 }
 
-INSTANTIATE_TEST_SUITE_P(Data, SharedMeshes,
-                         ::testing::Values(SharedMeshCase{"mushroom.off", 2337, 4608, 0, 1},
-                                           SharedMeshCase{"heart.off", 8896, 17788, 0, 0},
-                                           SharedMeshCase{"bear.off", 13826, 27648, 0, 0},
-                                           SharedMeshCase{"blobby.off", 2027, 4050, 0, 0},
-                                           SharedMeshCase{"retinal.off", 3643, 7282, 0, 0},
-                                           SharedMeshCase{"elephant.off", 2775, 5558, 3, 0},
-                                           SharedMeshCase{"lion.off", 7529, 14859, 0, 5}),
-                         [](const auto& info) {
-                           std::string n = info.param.file;
-                           return n.substr(0, n.find('.'));
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    Data, SharedMeshes,
+    ::testing::Values(SharedMeshCase{"mushroom.off", 2337, 4608, 0, 1}, SharedMeshCase{"heart.off", 8896, 17788, 0, 0},
+                      SharedMeshCase{"bear.off", 13826, 27648, 0, 0}, SharedMeshCase{"blobby.off", 2027, 4050, 0, 0},
+                      SharedMeshCase{"retinal.off", 3643, 7282, 0, 0}, SharedMeshCase{"elephant.off", 2775, 5558, 3, 0},
+                      SharedMeshCase{"lion.off", 7529, 14859, 0, 5}),
+    [](const auto& info) {
+      std::string n = info.param.file;
+      return n.substr(0, n.find('.'));
+    });
 
 TEST(InfoCommand, ReportsGenusAndLoopsAsJson) {
   MRSNAKE_REQUIRE_DATA(elephant, "meshes/elephant.off");

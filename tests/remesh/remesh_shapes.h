@@ -42,7 +42,8 @@ inline TriMesh capsule(double length, int around = 16) {
   const double pi = 3.14159265358979323846;
   std::vector<std::pair<double, double>> rings;  // (z, radius), bottom to top
   const int cap_rings = around / 4;
-  for (int i = 1; i <= cap_rings; ++i) rings.emplace_back(-std::cos(0.5 * pi * i / cap_rings), std::sin(0.5 * pi * i / cap_rings));
+  for (int i = 1; i <= cap_rings; ++i)
+    rings.emplace_back(-std::cos(0.5 * pi * i / cap_rings), std::sin(0.5 * pi * i / cap_rings));
   const int tube = static_cast<int>(std::lround(length / (2 * pi / around)));
   for (int j = 1; j <= tube; ++j) rings.emplace_back(length * j / tube, 1.0);
   for (int i = 1; i < cap_rings; ++i)
@@ -90,7 +91,8 @@ inline RowMatrixX3d sheared_layout(RowMatrixX3d U, const RowMatrixX3i& F) {
 struct EllipsoidLayout {
   explicit EllipsoidLayout(int grid_levels = 3, bool sheared = false)
       : grid(icosphere(grid_levels)),
-        U(sheared ? sheared_layout(grid.V.rowwise().normalized(), grid.F) : RowMatrixX3d(grid.V.rowwise().normalized())),
+        U(sheared ? sheared_layout(grid.V.rowwise().normalized(), grid.F)
+                  : RowMatrixX3d(grid.V.rowwise().normalized())),
         hints(U.rows(), 0),
         X(lift_to_surface(domain, param.surface.V, U, hints)) {}
   TriMesh input = ellipsoid(4);

@@ -26,8 +26,8 @@
 namespace mrsnake {
 namespace {
 
-using test::EllipsoidLayout;
 using test::ellipsoid;
+using test::EllipsoidLayout;
 
 // Point density 4 on the x > 0 half: farthest points with squared distances scaled by it
 // space the samples half as far apart there (about 4 x as many); without it both halves get
@@ -131,7 +131,8 @@ TEST(TriangleRepair, ProjectsItsMovesOntoTheOriginalInput) {
   ASSERT_GT(on_fine.distances(lift_to_surface(domain, param.surface.V, U, hints)).maxCoeff(), 1e-3 * diag);
   TriangleRepairOptions options;
   options.project_onto = &on_fine;
-  const TriangleRepairStats stats = repair_worst_triangles(DomainKind::sphere, F, domain, param.surface.V, U, X, hints, options);
+  const TriangleRepairStats stats =
+      repair_worst_triangles(DomainKind::sphere, F, domain, param.surface.V, U, X, hints, options);
   EXPECT_GT(stats.moves, 0);
   EXPECT_GT(stats.q_min_after, stats.q_min_before + 0.2);
   EXPECT_NEAR(stats.q_min_after, mesh_quality(TriMesh{X, F}).q_min, 1e-12);
@@ -166,7 +167,8 @@ TEST(FeatureSnap, SnapsVerticesOntoTheTipsTheLevelCutsOff) {
     ++moved;
     // Exactly an input vertex.
     double nearest = std::numeric_limits<double>::infinity();
-    for (int s = 0; s < param.surface.num_vertices(); ++s) nearest = std::min(nearest, (param.surface.V.row(s) - X.row(v)).norm());
+    for (int s = 0; s < param.surface.num_vertices(); ++s)
+      nearest = std::min(nearest, (param.surface.V.row(s) - X.row(v)).norm());
     EXPECT_EQ(nearest, 0.0);
     for (int f = 0; f < F.rows(); ++f) {
       if (F(f, 0) != v && F(f, 1) != v && F(f, 2) != v) continue;
@@ -246,7 +248,6 @@ TEST(TriangleRepair, KeepsFixedVerticesInPlace) {
   EXPECT_GT(fixed_would_move, 0);
 }
 
-
 // Whatever the options, snaps are kept only if together they lower the largest input-to-level
 // distance by min_gain; otherwise nothing moves.
 TEST(FeatureSnap, KeepsSnapsOnlyIfTheLargestDistanceDrops) {
@@ -260,13 +261,15 @@ TEST(FeatureSnap, KeepsSnapsOnlyIfTheLargestDistanceDrops) {
       options.min_share_of_largest = share;
       options.min_gain = gain;
       const double largest = SurfaceLocator(TriMesh{s.X, s.grid.F}).distances(s.param.surface.V).maxCoeff();
-      const int snaps = snap_to_input_tips(DomainKind::sphere, s.grid.F, s.domain, s.param.surface.V, s.U, s.X, s.hints, options);
+      const int snaps =
+          snap_to_input_tips(DomainKind::sphere, s.grid.F, s.domain, s.param.surface.V, s.U, s.X, s.hints, options);
       if (snaps == 0) {
         EXPECT_TRUE(s.U == before.U && s.X == before.X && s.hints == before.hints);
         continue;
       }
       ++kept;
-      EXPECT_LE(SurfaceLocator(TriMesh{s.X, s.grid.F}).distances(s.param.surface.V).maxCoeff(), (1 - gain) * largest + 1e-12);
+      EXPECT_LE(SurfaceLocator(TriMesh{s.X, s.grid.F}).distances(s.param.surface.V).maxCoeff(),
+                (1 - gain) * largest + 1e-12);
     }
   EXPECT_GT(kept, 0);
 }

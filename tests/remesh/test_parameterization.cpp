@@ -68,7 +68,8 @@ TEST(MeanValueMap, SolvesTheMeanValueSystemAsAPlainSparseLUDoesWithoutFlips) {
   for (int v = 0; v < n; ++v)
     if (boundary[v]) {
       ++rim;
-      EXPECT_NEAR((uv.row(v) - Eigen::RowVector2d(0.5, 0.5)).norm(), 0.5, 1e-12) << v;  // on CGAL's unit-diameter circle
+      EXPECT_NEAR((uv.row(v) - Eigen::RowVector2d(0.5, 0.5)).norm(), 0.5, 1e-12)
+          << v;  // on CGAL's unit-diameter circle
     }
   ASSERT_GT(rim, 50);
 
@@ -181,7 +182,8 @@ int count_spikes(const TriMesh& mesh, const std::vector<int>& side) {
 
 // A plane cut along the edges of an uneven mesh (a sphere's, its vertices jittered like a
 // marching-cubes surface's) zigzags: spikes of one or two triangles. The cleanup must remove
-// almost all of them (moving the ears alone leaves 16 of 78), and leave no face with three corners on the cut (flat on the equator).
+// almost all of them (moving the ears alone leaves 16 of 78), and leave no face with three corners on the cut (flat on
+// the equator).
 TEST(SphereMap, CutCleanupRemovesMostSpikesOfAPlaneCut) {
   TriMesh mesh = icosphere(4);
   std::mt19937 rng(7);

@@ -93,7 +93,8 @@ void expect_nested_and_valid(const RemeshResult& r, const TriMesh& input, bool c
       const RowMatrixX3i& F = conn.faces[j];
       for (int f = 0; f < F.rows(); ++f)
         for (int k = 0; k < 3; ++k)
-          longest_edge = std::max(longest_edge, (r.levels[j].positions.row(F(f, k)) - r.levels[j].positions.row(F(f, (k + 1) % 3))).norm());
+          longest_edge = std::max(
+              longest_edge, (r.levels[j].positions.row(F(f, k)) - r.levels[j].positions.row(F(f, (k + 1) % 3))).norm());
       EXPECT_LE(off_surface, 0.15 * longest_edge + 1e-9 * diag);
       EXPECT_GT(off_surface, 0.0);  // the fit ran
     }
@@ -189,8 +190,10 @@ TEST(Remesh, DiskInputStaysADiskWithBoundaryOnTheCircle) {
   const auto boundary = boundary_vertices(r.connectivity.faces.back(), static_cast<int>(D.rows()));
   for (int v = 0; v < D.rows(); ++v) {
     EXPECT_DOUBLE_EQ(D(v, 2), 1.0);
-    if (boundary[v]) EXPECT_NEAR(std::hypot(D(v, 0), D(v, 1)), 1.0, 1e-12);
-    else EXPECT_LT(std::hypot(D(v, 0), D(v, 1)), 1.0);
+    if (boundary[v])
+      EXPECT_NEAR(std::hypot(D(v, 0), D(v, 1)), 1.0, 1e-12);
+    else
+      EXPECT_LT(std::hypot(D(v, 0), D(v, 1)), 1.0);
   }
 }
 
@@ -282,12 +285,12 @@ TEST(Sizing, CurvatureOfASphereIsOneOverItsRadius) {
 // constrained Lloyd iteration flips nothing.
 TEST(Lloyd, CellStaysInsideANonConvexOneRing) {
   RowMatrixX3d U(7, 3);
-  U << 0, 0, 1,          // v
-      1.0, 0.0, 1,        //
-      0.5, 0.05, 1,       // reflex ring vertex, close to v: non-convex ring
-      0.0, 1.0, 1,        //
-      -1.0, 0.2, 1,       //
-      -0.6, -1.0, 1,      //
+  U << 0, 0, 1,       // v
+      1.0, 0.0, 1,    //
+      0.5, 0.05, 1,   // reflex ring vertex, close to v: non-convex ring
+      0.0, 1.0, 1,    //
+      -1.0, 0.2, 1,   //
+      -0.6, -1.0, 1,  //
       0.6, -1.0, 1;
   RowMatrixX3i F(6, 3);
   F << 0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 5, 0, 5, 6, 0, 6, 1;
@@ -309,14 +312,16 @@ TEST(Lloyd, CellStaysInsideANonConvexOneRing) {
   const double d = 2 * (a.x() * (b.y() - c.y()) + b.x() * (c.y() - a.y()) + c.x() * (a.y() - b.y()));
   const Eigen::Vector3d circumcenter(
       (a.squaredNorm() * (b.y() - c.y()) + b.squaredNorm() * (c.y() - a.y()) + c.squaredNorm() * (a.y() - b.y())) / d,
-      (a.squaredNorm() * (c.x() - b.x()) + b.squaredNorm() * (a.x() - c.x()) + c.squaredNorm() * (b.x() - a.x())) / d, 1);
+      (a.squaredNorm() * (c.x() - b.x()) + b.squaredNorm() * (a.x() - c.x()) + c.squaredNorm() * (b.x() - a.x())) / d,
+      1);
   EXPECT_FALSE(inside_ring(circumcenter));
   const auto cell = lloyd_cell(F, U, 0);
   ASSERT_EQ(cell.size(), 6u);
   double cell_area = 0, ring_area = 0;
   for (const auto& quad : cell) {
     for (const auto& p : quad) EXPECT_TRUE(inside_ring(p)) << p.transpose();
-    cell_area += 0.5 * ((quad[1] - quad[0]).cross(quad[2] - quad[0]).norm() + (quad[2] - quad[0]).cross(quad[3] - quad[0]).norm());
+    cell_area += 0.5 * ((quad[1] - quad[0]).cross(quad[2] - quad[0]).norm() +
+                        (quad[2] - quad[0]).cross(quad[3] - quad[0]).norm());
   }
   for (int f = 0; f < F.rows(); ++f)
     ring_area += 0.5 * (U.row(F(f, 1)) - U.row(F(f, 0))).cross(U.row(F(f, 2)) - U.row(F(f, 0))).norm();
@@ -405,7 +410,8 @@ TEST(TriangleRepair, GuardKeepsEdgesAsCloseToTheSurface) {
       const DomainMesh::Location loc = domain.locate(mid, hint);
       hint = loc.face;
       Eigen::Vector3d lifted = Eigen::Vector3d::Zero();
-      for (int k = 0; k < 3; ++k) lifted += loc.barycentric[k] * param.surface.V.row(domain.faces()(loc.face, k)).transpose();
+      for (int k = 0; k < 3; ++k)
+        lifted += loc.barycentric[k] * param.surface.V.row(domain.faces()(loc.face, k)).transpose();
       error = std::max(error, (lifted - 0.5 * (X.row(a) + X.row(b)).transpose()).norm());
     }
     return error;
@@ -421,7 +427,8 @@ TEST(TriangleRepair, GuardKeepsEdgesAsCloseToTheSurface) {
     TriangleRepairOptions options;
     options.guard_surface_error = guard;
     options.error_tolerance = 0;
-    const TriangleRepairStats stats = repair_worst_triangles(DomainKind::sphere, F, domain, param.surface.V, U, X, hints, options);
+    const TriangleRepairStats stats =
+        repair_worst_triangles(DomainKind::sphere, F, domain, param.surface.V, U, X, hints, options);
     EXPECT_GT(stats.moves, 0);
     EXPECT_GT(stats.q_min_after, stats.q_min_before);
     after[guard ? 0 : 1] = largest_edge_error(U, X);
@@ -560,7 +567,8 @@ TEST(RemeshCli, WritesNestedLevelsAndReport) {
   ASSERT_EQ(halves.exit_code, 0) << halves.output;
   std::ifstream in_halves(dir / "halves" / "report.json");
   EXPECT_GT(nlohmann::json::parse(in_halves)["parameterization"].value("cut_vertices", 0), 0);
-  EXPECT_EQ(test::run_mrsnake("-q remesh " + input + " -o " + (dir / "bad").string() + " --sphere-map north").exit_code, 2);
+  EXPECT_EQ(test::run_mrsnake("-q remesh " + input + " -o " + (dir / "bad").string() + " --sphere-map north").exit_code,
+            2);
   // The finest level is fitted by default (report key "fit"); --fit-rounds 0 turns it off.
   EXPECT_EQ(report["fit_rounds"].get<int>(), 1);
   EXPECT_TRUE(report["per_level"][2].contains("fit"));
@@ -573,7 +581,8 @@ TEST(RemeshCli, WritesNestedLevelsAndReport) {
   EXPECT_FALSE(unfitted_report["per_level"][2].contains("fit"));
   EXPECT_LT(report["per_level"][2]["distance"]["rms_pct"].get<double>(),
             unfitted_report["per_level"][2]["distance"]["rms_pct"].get<double>());
-  EXPECT_EQ(test::run_mrsnake("-q remesh " + input + " -o " + (dir / "bad").string() + " --fit-rounds -1").exit_code, 2);
+  EXPECT_EQ(test::run_mrsnake("-q remesh " + input + " -o " + (dir / "bad").string() + " --fit-rounds -1").exit_code,
+            2);
   std::filesystem::remove_all(dir);
 }
 

@@ -30,7 +30,7 @@ Eigen::VectorXd normal_offsets(const TriMesh& before, const RowMatrixX3d& after)
 // the centroid sag around it (corners weigh 1/4 with residual -t, the centroid 3/4 with s_c - t):
 // the fit must find that, outward, and cut the distance to the sphere accordingly.
 TEST(SurfaceFit, MovesAnIcosphereOutwardByThreeQuartersOfTheCentroidSag) {
-  const TriMesh level = icosphere(2);  // 162 vertices, edges ~0.3: centroid sag ~0.015
+  const TriMesh level = icosphere(2);   // 162 vertices, edges ~0.3: centroid sag ~0.015
   const TriMesh sphere = icosphere(6);  // the input: 40962 vertices, its own sag ~5e-5
   const SurfaceLocator locator(sphere);
   RowMatrixX3d X = level.V;
@@ -39,7 +39,8 @@ TEST(SurfaceFit, MovesAnIcosphereOutwardByThreeQuartersOfTheCentroidSag) {
 
   std::vector<double> sag_sum(level.V.rows(), 0.0), sag_count(level.V.rows(), 0.0);
   for (int f = 0; f < level.F.rows(); ++f) {
-    const Eigen::Vector3d c = (level.V.row(level.F(f, 0)) + level.V.row(level.F(f, 1)) + level.V.row(level.F(f, 2))) / 3.0;
+    const Eigen::Vector3d c =
+        (level.V.row(level.F(f, 0)) + level.V.row(level.F(f, 1)) + level.V.row(level.F(f, 2))) / 3.0;
     for (int k = 0; k < 3; ++k) {
       sag_sum[level.F(f, k)] += 1.0 - c.norm();
       sag_count[level.F(f, k)] += 1;
@@ -103,8 +104,10 @@ TEST(SurfaceFit, HonoursFixedVerticesTheOffsetLimitAndTheQualityFloor) {
   fit_to_surface(level.F, X, locator, {}, fixed);
   int moved = 0;
   for (int v = 0; v < level.V.rows(); ++v) {
-    if (fixed[v]) EXPECT_EQ(X.row(v), level.V.row(v)) << v;
-    else moved += (X.row(v) - level.V.row(v)).norm() > 0;
+    if (fixed[v])
+      EXPECT_EQ(X.row(v), level.V.row(v)) << v;
+    else
+      moved += (X.row(v) - level.V.row(v)).norm() > 0;
   }
   EXPECT_GT(moved, level.V.rows() / 2);
 
@@ -116,8 +119,7 @@ TEST(SurfaceFit, HonoursFixedVerticesTheOffsetLimitAndTheQualityFloor) {
 
   // A jittered sphere, so that the fit would change triangle shapes.
   TriMesh jittered = level;
-  for (int v = 0; v < jittered.V.rows(); ++v)
-    jittered.V.row(v) *= 1.0 + 0.02 * std::sin(7.0 * v);
+  for (int v = 0; v < jittered.V.rows(); ++v) jittered.V.row(v) *= 1.0 + 0.02 * std::sin(7.0 * v);
   SurfaceFitOptions strict;
   strict.quality_floor = 1.0;
   X = jittered.V;

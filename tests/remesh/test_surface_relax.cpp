@@ -20,8 +20,8 @@
 namespace mrsnake {
 namespace {
 
-using test::EllipsoidLayout;
 using test::ellipsoid;
+using test::EllipsoidLayout;
 using test::spherical_cap;
 
 std::vector<double> face_areas(const RowMatrixX3d& X, const RowMatrixX3i& F) {
@@ -51,7 +51,8 @@ TEST(SurfaceRelaxation, EvensOutTriangleAreasOnTheSurfaceWithoutFlips) {
   options.iterations = 30;
   options.step = 1.0;
   options.target = SmoothingTarget::area_centroid;
-  const int moves = smooth_shapes_in_domain(DomainKind::sphere, F, s.domain, s.param.surface.V, s.U, s.X, s.hints, options);
+  const int moves =
+      smooth_shapes_in_domain(DomainKind::sphere, F, s.domain, s.param.surface.V, s.U, s.X, s.hints, options);
   EXPECT_GT(moves, 0);
   const double cv_after = coefficient_of_variation(face_areas(s.X, F));
   EXPECT_LT(cv_after, 0.8 * cv_before) << cv_before << " -> " << cv_after;
@@ -129,7 +130,9 @@ TEST(SurfaceRelaxation, QualityFloorKeepsTheWorstTriangle) {
     options.step = 1.0;
     options.target = SmoothingTarget::area_centroid;
     options.quality_floor = quality_floor;
-    EXPECT_GT(smooth_shapes_in_domain(DomainKind::sphere, s.grid.F, s.domain, s.param.surface.V, s.U, s.X, s.hints, options), 0);
+    EXPECT_GT(
+        smooth_shapes_in_domain(DomainKind::sphere, s.grid.F, s.domain, s.param.surface.V, s.U, s.X, s.hints, options),
+        0);
     EXPECT_EQ(count_flipped(s.U, s.grid.F), 0);
     after.push_back(smallest_q(s.X, s.grid.F));
   }
@@ -161,8 +164,10 @@ TEST(SurfaceRelaxation, RimVerticesSlideAlongTheRimAndStayOnTheCircle) {
     const Eigen::RowVector3d before = U0.row(v);
     const double angle = std::atan2(U0(v, 1), U0(v, 0)) + 0.03;
     U0.row(v) << std::cos(angle), std::sin(angle), 1.0;
-    if (count_flipped(U0, F) > 0) U0.row(v) = before;
-    else ++turned;
+    if (count_flipped(U0, F) > 0)
+      U0.row(v) = before;
+    else
+      ++turned;
   }
   ASSERT_GT(turned, 4);
   auto rim_cv = [&](const RowMatrixX3d& X) {

@@ -60,8 +60,8 @@ std::vector<double> brute_force_distances(const Volume& a, const Volume& b) {
     for (long k = 0; k < long(v.size[2]); ++k)
       for (long j = 0; j < long(v.size[1]); ++j)
         for (long i = 0; i < long(v.size[0]); ++i)
-          if (in(i, j, k) && !(in(i - 1, j, k) && in(i + 1, j, k) && in(i, j - 1, k) && in(i, j + 1, k) && in(i, j, k - 1) &&
-                               in(i, j, k + 1)))
+          if (in(i, j, k) && !(in(i - 1, j, k) && in(i + 1, j, k) && in(i, j - 1, k) && in(i, j + 1, k) &&
+                               in(i, j, k - 1) && in(i, j, k + 1)))
             points.push_back(v.index_to_physical(i, j, k));
     return points;
   };
@@ -212,7 +212,8 @@ TEST(Evaluate, DifferentGridsAreRefusedWithTheReason) {
   EXPECT_NE(message(box(grid({10, 10, 11}, {1, 1, 1}), {2, 2, 2}, {8, 8, 8})).find("sizes 10x10x10 and 10x10x11"),
             std::string::npos);
   EXPECT_NE(message(box(grid({10, 10, 10}, {1, 1, 2}), {2, 2, 2}, {8, 8, 8})).find("spacings"), std::string::npos);
-  EXPECT_NE(message(box(grid({10, 10, 10}, {1, 1, 1}, {0, 0.5, 0}), {2, 2, 2}, {8, 8, 8})).find("origins"), std::string::npos);
+  EXPECT_NE(message(box(grid({10, 10, 10}, {1, 1, 1}, {0, 0.5, 0}), {2, 2, 2}, {8, 8, 8})).find("origins"),
+            std::string::npos);
   Volume rotated = a;
   rotated.direction = {0, 1, 0, 1, 0, 0, 0, 0, -1};
   EXPECT_NE(message(rotated).find("direction"), std::string::npos);
@@ -221,7 +222,8 @@ TEST(Evaluate, DifferentGridsAreRefusedWithTheReason) {
 TEST(EvaluateCli, ScoresFilesAndRefusesBadInput) {
   const auto dir = test::scratch_dir("evaluate-cli");
   const Volume g = grid({24, 24, 24}, {1, 1, 1}, {-12, -12, -12});
-  const std::string t = (dir / "t.nii.gz").string(), s = (dir / "s.nii.gz").string(), other = (dir / "o.nii.gz").string();
+  const std::string t = (dir / "t.nii.gz").string(), s = (dir / "s.nii.gz").string(),
+                    other = (dir / "o.nii.gz").string();
   write_volume(t, ball(g, {0, 0, 0}, 8), VoxelType::uint8);
   write_volume(s, ball(g, {1, 0, 0}, 8), VoxelType::uint8);
   write_volume(other, ball(grid({20, 24, 24}, {1, 1, 1}), {10, 12, 12}, 8), VoxelType::uint8);
@@ -258,7 +260,8 @@ TEST(EvaluateCli, ScoresFilesAndRefusesBadInput) {
   const auto jm = nlohmann::json::parse(meshes.output).at("surface_distance");
   EXPECT_NEAR(jm.at("mean_mm").get<double>(), 1.0, 0.05);
   EXPECT_NEAR(jm.at("hausdorff_mm").get<double>(), 1.0, 0.1);
-  auto both = test::run_mrsnake("evaluate --seg " + s + " --truth " + t + " --seg-mesh " + m1 + " --truth-mesh " + m1 + " --json");
+  auto both = test::run_mrsnake("evaluate --seg " + s + " --truth " + t + " --seg-mesh " + m1 + " --truth-mesh " + m1 +
+                                " --json");
   ASSERT_EQ(both.exit_code, 0) << both.output;
   const auto jb = nlohmann::json::parse(both.output);
   EXPECT_TRUE(jb.contains("dice"));

@@ -106,7 +106,8 @@ SphereCase sphere_case(const std::array<int, 3>& size, int seed, double radius) 
   c.centre = c.target.truth_mesh.V.colwise().mean();
   c.radius = radius;
   if (c.radius <= 0) {
-    for (int v = 0; v < c.target.truth_mesh.num_vertices(); ++v) c.radius += (c.target.truth_mesh.V.row(v) - c.centre).norm();
+    for (int v = 0; v < c.target.truth_mesh.num_vertices(); ++v)
+      c.radius += (c.target.truth_mesh.V.row(v) - c.centre).norm();
     c.radius /= c.target.truth_mesh.num_vertices();
   }
   const TriMesh ico = icosahedron();
@@ -158,10 +159,11 @@ PoseErrors register_and_measure(const PosedPair& pair, const char* name) {
   std::printf("%s: registration %.3f s on pyramid level %d, metric %.4f -> %.4f, iterations", name, r.seconds,
               r.pyramid_level, r.result.initial_metric, r.result.final_metric);
   for (int it : r.result.iterations) std::printf(" %d", it);
-  std::printf(", edge radius %.1f mm (%s)\n  rotation error %.3f deg, scale error %.3f%%, centre error %.3f mm, "
-              "surface error mean %.3f max %.3f mm\n",
-              r.result.edge_radius_mm, r.result.stop_condition.c_str(), e.angle_deg, 100 * e.scale, e.centre_mm,
-              e.surface_mean_mm, e.surface_max_mm);
+  std::printf(
+      ", edge radius %.1f mm (%s)\n  rotation error %.3f deg, scale error %.3f%%, centre error %.3f mm, "
+      "surface error mean %.3f max %.3f mm\n",
+      r.result.edge_radius_mm, r.result.stop_condition.c_str(), e.angle_deg, 100 * e.scale, e.centre_mm,
+      e.surface_mean_mm, e.surface_max_mm);
   return e;
 }
 
@@ -356,7 +358,8 @@ TEST(Registration, SegmentFallsBackToTheMomentsRouteAndSaysSo) {
   EXPECT_EQ(rep["init_used"], "moments+fit");
   EXPECT_EQ(rep["registration"]["accepted"], false);
   EXPECT_EQ(rep["registration"]["fallback"], "moments+fit");
-  EXPECT_NE(rep["registration"]["rejection"].get<std::string>().find("overlap"), std::string::npos) << rep["registration"];
+  EXPECT_NE(rep["registration"]["rejection"].get<std::string>().find("overlap"), std::string::npos)
+      << rep["registration"];
   // Without a reference image, asking for the registration is an input error; auto falls
   // back silently.
   model.reference_image.reset();
@@ -434,7 +437,8 @@ TEST(ReferenceImageSection, RoundTripsAndRefusesDamage) {
   EXPECT_THROW(deserialize_reference_image(tiny), InputError);
   // Every truncation is refused.
   for (std::size_t n = 0; n < bytes.size(); ++n)
-    EXPECT_THROW(deserialize_reference_image(std::vector<std::uint8_t>(bytes.begin(), bytes.begin() + long(n))), InputError)
+    EXPECT_THROW(deserialize_reference_image(std::vector<std::uint8_t>(bytes.begin(), bytes.begin() + long(n))),
+                 InputError)
         << n << " bytes";
   // Impossible frames and values behind a valid checksum are refused too.
   const auto with_double = [&](std::size_t offset, double value) {
@@ -445,17 +449,18 @@ TEST(ReferenceImageSection, RoundTripsAndRefusesDamage) {
     b.insert(b.end(), p, p + 8);
     return b;
   };
-  EXPECT_NO_THROW(deserialize_reference_image(with_double(24, 1.5)));  // the same spacing: still valid
-  EXPECT_THROW(deserialize_reference_image(with_double(24, 0.0)), InputError);                 // spacing x
-  EXPECT_THROW(deserialize_reference_image(with_double(56, std::nan(""))), InputError);        // origin y
-  EXPECT_THROW(deserialize_reference_image(with_double(72, 2.0)), InputError);                 // direction (0,0)
-  EXPECT_THROW(deserialize_reference_image(with_double(32, 1e200)), InputError);               // spacing z, finite
-  EXPECT_THROW(deserialize_reference_image(with_double(48, -1e12)), InputError);               // origin x, finite
+  EXPECT_NO_THROW(deserialize_reference_image(with_double(24, 1.5)));           // the same spacing: still valid
+  EXPECT_THROW(deserialize_reference_image(with_double(24, 0.0)), InputError);  // spacing x
+  EXPECT_THROW(deserialize_reference_image(with_double(56, std::nan(""))), InputError);  // origin y
+  EXPECT_THROW(deserialize_reference_image(with_double(72, 2.0)), InputError);           // direction (0,0)
+  EXPECT_THROW(deserialize_reference_image(with_double(32, 1e200)), InputError);         // spacing z, finite
+  EXPECT_THROW(deserialize_reference_image(with_double(48, -1e12)), InputError);         // origin x, finite
   std::vector<std::uint8_t> nan_value(bytes.begin(), bytes.end() - 8);
   const float nan = std::nanf("");
   std::memcpy(nan_value.data() + 144, &nan, 4);
   const std::uint64_t h = fnv1a64(nan_value.data(), nan_value.size());
-  nan_value.insert(nan_value.end(), reinterpret_cast<const std::uint8_t*>(&h), reinterpret_cast<const std::uint8_t*>(&h) + 8);
+  nan_value.insert(nan_value.end(), reinterpret_cast<const std::uint8_t*>(&h),
+                   reinterpret_cast<const std::uint8_t*>(&h) + 8);
   EXPECT_THROW(deserialize_reference_image(nan_value), InputError);
 }
 

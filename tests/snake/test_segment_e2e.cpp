@@ -94,25 +94,36 @@ CaseOutcome run_case(SynthShape shape, std::uint64_t target_seed, std::uint64_t 
       if (eq == std::string::npos) continue;
       const std::string key = item.substr(0, eq);
       const double v = std::stod(item.substr(eq + 1));
-      if (key == "external") opts.snake.external_weight = v;
-      else if (key == "tangential") opts.snake.tangential_weight = v;
-      else if (key == "prior") opts.snake.prior_weight = v;
-      else if (key == "median") opts.snake.offset_median = static_cast<int>(v);
-      else if (key == "min_range_voxels") opts.min_range_voxels = v;
-      else if (key == "max_profile_cost") opts.max_profile_cost = v;
-      else if (key == "profile_step") opts.profile_step_fraction = v;
-      else if (key == "min_edge_voxels") opts.min_edge_voxels = v;
-      else ADD_FAILURE() << "unknown MRSNAKE_E2E_OPTIONS key " << key;
+      if (key == "external")
+        opts.snake.external_weight = v;
+      else if (key == "tangential")
+        opts.snake.tangential_weight = v;
+      else if (key == "prior")
+        opts.snake.prior_weight = v;
+      else if (key == "median")
+        opts.snake.offset_median = static_cast<int>(v);
+      else if (key == "min_range_voxels")
+        opts.min_range_voxels = v;
+      else if (key == "max_profile_cost")
+        opts.max_profile_cost = v;
+      else if (key == "profile_step")
+        opts.profile_step_fraction = v;
+      else if (key == "min_edge_voxels")
+        opts.min_edge_voxels = v;
+      else
+        ADD_FAILURE() << "unknown MRSNAKE_E2E_OPTIONS key " << key;
     }
   }
   const SegmentResult r = segment(target.image, model, opts);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  out.start = evaluate_segmentation(rasterize_mesh(TriMesh{model.levels.back(), model.faces(model.finest_level())}, target.truth),
-                                    target.truth);
+  out.start = evaluate_segmentation(
+      rasterize_mesh(TriMesh{model.levels.back(), model.faces(model.finest_level())}, target.truth), target.truth);
   const SegmentationScores initial = evaluate_segmentation(
-      rasterize_mesh(TriMesh{r.initial_pose.apply(model.levels.back()), model.faces(model.finest_level())}, target.truth),
+      rasterize_mesh(TriMesh{r.initial_pose.apply(model.levels.back()), model.faces(model.finest_level())},
+                     target.truth),
       target.truth);
-  std::printf("after initialization: Dice %.4f (fit iterations %d), region in %.3f out %.3f\n", initial.dice, r.fit_iterations, r.region.inside, r.region.outside);
+  std::printf("after initialization: Dice %.4f (fit iterations %d), region in %.3f out %.3f\n", initial.dice,
+              r.fit_iterations, r.region.inside, r.region.outside);
   out.final = evaluate_segmentation(rasterize_mesh(r.surface, target.truth), target.truth);
   out.self_intersections = r.self_intersections;
   if (std::getenv("MRSNAKE_E2E_DUMP")) {
@@ -120,8 +131,13 @@ CaseOutcome run_case(SynthShape shape, std::uint64_t target_seed, std::uint64_t 
     const Eigen::VectorXd d = loc.distances(r.surface.V);
     int over1 = 0;
     for (int i = 0; i < d.size(); ++i) over1 += d[i] > 1.0;
-    std::printf("enclosed volume final/truth %.4f, model/ref %.4f\n", enclosed_volume(r.surface) / enclosed_volume(target.truth_mesh), enclosed_volume(TriMesh{model.levels.back(), model.faces(model.finest_level())}) / enclosed_volume(ref.truth_mesh));
-    for (const auto& l : r.levels) std::printf("  level %d volume ratio %.4f\n", l.level, enclosed_volume(l.surface) / enclosed_volume(target.truth_mesh));
+    std::printf("enclosed volume final/truth %.4f, model/ref %.4f\n",
+                enclosed_volume(r.surface) / enclosed_volume(target.truth_mesh),
+                enclosed_volume(TriMesh{model.levels.back(), model.faces(model.finest_level())}) /
+                    enclosed_volume(ref.truth_mesh));
+    for (const auto& l : r.levels)
+      std::printf("  level %d volume ratio %.4f\n", l.level,
+                  enclosed_volume(l.surface) / enclosed_volume(target.truth_mesh));
     std::printf("vertex-to-truth: mean %.3f max %.3f, >1mm: %d of %d\n", d.mean(), d.maxCoeff(), over1, int(d.size()));
     const std::string dir = std::string("/tmp/e2e_") + to_string(shape);
     std::filesystem::create_directories(dir);
@@ -130,7 +146,8 @@ CaseOutcome run_case(SynthShape shape, std::uint64_t target_seed, std::uint64_t 
     write_mesh(dir + "/model.vtp", TriMesh{model.levels.back(), model.faces(model.finest_level())});
     for (const auto& l : r.levels) write_mesh(dir + "/level_" + std::to_string(l.level) + ".vtp", l.surface);
     std::FILE* f = std::fopen((dir + "/err.txt").c_str(), "w");
-    for (int i = 0; i < d.size(); ++i) std::fprintf(f, "%f %f %f %f\n", r.surface.V(i, 0), r.surface.V(i, 1), r.surface.V(i, 2), d[i]);
+    for (int i = 0; i < d.size(); ++i)
+      std::fprintf(f, "%f %f %f %f\n", r.surface.V(i, 0), r.surface.V(i, 1), r.surface.V(i, 2), d[i]);
     std::fclose(f);
   }
   std::printf("volume difference %.2f%%\n", out.final.volume_difference_pct);
@@ -139,8 +156,8 @@ CaseOutcome run_case(SynthShape shape, std::uint64_t target_seed, std::uint64_t 
               out.self_intersections, out.seconds, out.model_fit_mm);
   for (const auto& l : r.levels)
     std::printf("   level %d: %6d vertices, pyramid %d, range %.1f mm, %2d it%s, offset %.3f mm, energy %.4f, %.3fs\n",
-                l.level, l.vertices, l.pyramid_level, l.range_mm, l.snake.iterations, l.snake.converged ? " (conv)" : "",
-                l.snake.mean_abs_offset_mm, l.snake.energy, l.seconds);
+                l.level, l.vertices, l.pyramid_level, l.range_mm, l.snake.iterations,
+                l.snake.converged ? " (conv)" : "", l.snake.mean_abs_offset_mm, l.snake.energy, l.seconds);
   return out;
 }
 
@@ -204,9 +221,11 @@ TEST(SegmentE2E, HeartLevelsFinerThanTheImageAreDeformedOnlyWithEdgeCentredProfi
   const double voxel = target.image.max_spacing();
   std::vector<int> fine_levels;
   for (int j = 0; j <= centred.finest_level(); ++j)
-    if (mean_edge_length(centred.levels[j], centred.faces(j)) < options.min_edge_voxels * voxel) fine_levels.push_back(j);
+    if (mean_edge_length(centred.levels[j], centred.faces(j)) < options.min_edge_voxels * voxel)
+      fine_levels.push_back(j);
   ASSERT_FALSE(fine_levels.empty()) << "the test needs a level finer than the image";
-  const SegmentResult with = segment(target.image, centred, options), without = segment(target.image, on_labels, options);
+  const SegmentResult with = segment(target.image, centred, options),
+                      without = segment(target.image, on_labels, options);
   const std::vector<SegmentResult> synthesized_only = {without, segment(target.image, unrecorded, options),
                                                        segment(target.image, centred, switched_off)};
   for (const int j : fine_levels) {
@@ -216,7 +235,8 @@ TEST(SegmentE2E, HeartLevelsFinerThanTheImageAreDeformedOnlyWithEdgeCentredProfi
     // σ = 1.85 voxels of averaging: k passes with k·(3/7)·edge² = σ².
     const double edge = mean_edge_length(centred.levels[j], centred.faces(j));
     const double sigma = options.fine.offset_smoothing_voxels * voxel;
-    EXPECT_EQ(with.levels[j].offset_smoothing, static_cast<int>(std::lround(sigma * sigma / (3.0 / 7.0 * edge * edge))));
+    EXPECT_EQ(with.levels[j].offset_smoothing,
+              static_cast<int>(std::lround(sigma * sigma / (3.0 / 7.0 * edge * edge))));
     EXPECT_EQ(with.levels[j].offset_smoothing, fine_level_snake_options(options, edge / voxel).offset_smoothing);
     EXPECT_GT(with.levels[j].offset_smoothing, options.snake.offset_smoothing) << j;
     for (const SegmentResult& r : synthesized_only) {
@@ -253,7 +273,8 @@ TEST(SegmentCommand, WritesEveryOutputOnTheImageGridWithScores) {
                                             (dir / "blob.model").string() + " -o " + (dir / "seg").string() +
                                             " --truth " + (dir / "truth.nii.gz").string() + " --json -q");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  for (const char* f : {"surface.vtp", "labels.nii.gz", "report.json", "report.html", "levels/level_0.vtp", "levels/level_4.vtp"})
+  for (const char* f :
+       {"surface.vtp", "labels.nii.gz", "report.json", "report.html", "levels/level_0.vtp", "levels/level_4.vtp"})
     EXPECT_TRUE(std::filesystem::exists(dir / "seg" / f)) << f;
   {
     // The page: three slices, a convergence plot per level plus the offsets of all levels.
@@ -306,15 +327,17 @@ TEST(SegmentCommand, SynthBuildModelWithImageThenSegment) {
   const auto dir = mrsnake::test::scratch_dir("segment-roundtrip");
   const std::string d = dir.string();
   for (const auto& [name, seed] : {std::pair<std::string, int>{"ref", 22}, {"tgt", 21}}) {
-    const auto r = mrsnake::test::run_mrsnake("-q synth --shape blob --size 56 --snr 4 --pose random --deform 2 --seed " +
-                                              std::to_string(seed) + " -o " + d + "/" + name);
+    const auto r =
+        mrsnake::test::run_mrsnake("-q synth --shape blob --size 56 --snr 4 --pose random --deform 2 --seed " +
+                                   std::to_string(seed) + " -o " + d + "/" + name);
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
-  const auto b = mrsnake::test::run_mrsnake("-q build-model --labels " + d + "/ref/truth.nii.gz --label 1 --image " + d +
-                                            "/ref/image.nii.gz -o " + d + "/blob.model --faces 8000");
+  const auto b = mrsnake::test::run_mrsnake("-q build-model --labels " + d + "/ref/truth.nii.gz --label 1 --image " +
+                                            d + "/ref/image.nii.gz -o " + d + "/blob.model --faces 8000");
   ASSERT_EQ(b.exit_code, 0) << b.output;
-  const auto s = mrsnake::test::run_mrsnake("segment --image " + d + "/tgt/image.nii.gz --model " + d +
-                                            "/blob.model -o " + d + "/seg --truth " + d + "/tgt/truth.nii.gz --json -q");
+  const auto s =
+      mrsnake::test::run_mrsnake("segment --image " + d + "/tgt/image.nii.gz --model " + d + "/blob.model -o " + d +
+                                 "/seg --truth " + d + "/tgt/truth.nii.gz --json -q");
   ASSERT_EQ(s.exit_code, 0) << s.output;
   const nlohmann::json rep = nlohmann::json::parse(s.output);
   // The model has an appearance, and what it learned is a clean step (a blob on a flat
@@ -325,9 +348,9 @@ TEST(SegmentCommand, SynthBuildModelWithImageThenSegment) {
   EXPECT_GE(rep["scores"]["dice"].get<double>(), 0.95);
   std::printf("build-model --image + segment: Dice %.4f ASSD %.3f mm\n", rep["scores"]["dice"].get<double>(),
               rep["scores"]["assd_mm"].get<double>());
-  const auto sp = mrsnake::test::run_mrsnake("segment --image " + d + "/tgt/image.nii.gz --model " + d +
-                                             "/blob.model -o " + d + "/seg-profile --force profile --truth " + d +
-                                             "/tgt/truth.nii.gz --json -q");
+  const auto sp =
+      mrsnake::test::run_mrsnake("segment --image " + d + "/tgt/image.nii.gz --model " + d + "/blob.model -o " + d +
+                                 "/seg-profile --force profile --truth " + d + "/tgt/truth.nii.gz --json -q");
   ASSERT_EQ(sp.exit_code, 0) << sp.output;
   const nlohmann::json profile = nlohmann::json::parse(sp.output);
   EXPECT_EQ(profile["force"], "profile");
@@ -367,8 +390,9 @@ TEST(SegmentReal, LiverOfTheAbdomenCtReachesDice09WithoutSelfIntersections) {
     EXPECT_EQ(rep["levels"][finest]["iterations"], 0);
     EXPECT_TRUE(rep["levels"][finest - 1]["deformed"].get<bool>());
     dice[iterations == 0 ? 0 : 1] = rep["scores"]["dice"].get<double>();
-    std::printf("real liver%s: Dice %.4f ASSD %.3f mm, self-intersections %d\n", cap.c_str(), dice[iterations == 0 ? 0 : 1],
-                rep["scores"]["assd_mm"].get<double>(), rep["self_intersections"].get<int>());
+    std::printf("real liver%s: Dice %.4f ASSD %.3f mm, self-intersections %d\n", cap.c_str(),
+                dice[iterations == 0 ? 0 : 1], rep["scores"]["assd_mm"].get<double>(),
+                rep["self_intersections"].get<int>());
   }
   EXPECT_GE(dice[1], 0.9);
   EXPECT_GE(dice[1], dice[0] - 0.005);  // the snake does not make its start worse
@@ -383,16 +407,18 @@ TEST(SegmentReal, TheLateralVentriclesWithTheirHornsBuildAModelAndSegment) {
   MRSNAKE_REQUIRE_DATA(labels, "volumes/MRIcrop-seg.gipl.gz");
   const auto dir = mrsnake::test::scratch_dir("segment-real-ventricles");
   const std::string d = dir.string();
-  const auto b = mrsnake::test::run_mrsnake("-q build-model --labels " + labels + " --label 1 --component 1 --image " + image +
-                                            " -o " + d + "/ventricles.model");
+  const auto b = mrsnake::test::run_mrsnake("-q build-model --labels " + labels + " --label 1 --component 1 --image " +
+                                            image + " -o " + d + "/ventricles.model");
   ASSERT_EQ(b.exit_code, 0) << b.output;
   const nlohmann::json model = nlohmann::json::parse(std::ifstream(d + "/ventricles.model/model.json"));
-  EXPECT_EQ(model["remesh_quality"]["parameterization"]["sphere_map"], "hierarchical") << model["remesh_quality"]["parameterization"];
+  EXPECT_EQ(model["remesh_quality"]["parameterization"]["sphere_map"], "hierarchical")
+      << model["remesh_quality"]["parameterization"];
   const auto c = mrsnake::test::run_mrsnake("-q synth --from-image " + image + " --from-labels " + labels +
                                             " --label 1 --pose random --deform 2 --seed 7 -o " + d + "/case");
   ASSERT_EQ(c.exit_code, 0) << c.output;
-  const auto s = mrsnake::test::run_mrsnake("segment --image " + d + "/case/image.nii.gz --model " + d +
-                                            "/ventricles.model -o " + d + "/seg --truth " + d + "/case/truth.nii.gz --json -q");
+  const auto s =
+      mrsnake::test::run_mrsnake("segment --image " + d + "/case/image.nii.gz --model " + d + "/ventricles.model -o " +
+                                 d + "/seg --truth " + d + "/case/truth.nii.gz --json -q");
   ASSERT_EQ(s.exit_code, 0) << s.output;
   const nlohmann::json rep = nlohmann::json::parse(s.output);
   std::printf("lateral ventricles: Dice %.4f ASSD %.3f mm\n", rep["scores"]["dice"].get<double>(),
@@ -415,8 +441,8 @@ nlohmann::json segment_blob_at_scale(const std::string& dir, double scale, const
                                        contrast + " -o " + target)
                 .exit_code,
             0);
-  const auto b = mrsnake::test::run_mrsnake("-q build-model --labels " + ref + "/truth.nii.gz --label 1 --image " + ref +
-                                            "/image.nii.gz -o " + model);
+  const auto b = mrsnake::test::run_mrsnake("-q build-model --labels " + ref + "/truth.nii.gz --label 1 --image " +
+                                            ref + "/image.nii.gz -o " + model);
   EXPECT_EQ(b.exit_code, 0) << b.output;
   const auto s = mrsnake::test::run_mrsnake("-q segment --image " + target + "/image.nii.gz --model " + model + " -o " +
                                             dir + "/seg --truth " + target + "/truth.nii.gz");
@@ -476,7 +502,8 @@ TEST(SegmentCommand, AVolumeFarFromTheModelsIsFlagged) {
   const std::string model = (dir / "ball.model").string();
   ASSERT_EQ(mrsnake::test::run_mrsnake("-q build-model --labels " + whole + " --label 1 -o " + model).exit_code, 0);
   const std::string args = " --model " + model + " --init pose --max-iterations 0 -o ";
-  const auto same = mrsnake::test::run_mrsnake("-q segment --image " + whole + args + (dir / "same").string() + " --json");
+  const auto same =
+      mrsnake::test::run_mrsnake("-q segment --image " + whole + args + (dir / "same").string() + " --json");
   ASSERT_EQ(same.exit_code, 0) << same.output;
   const nlohmann::json ok = nlohmann::json::parse(same.output);
   EXPECT_FALSE(ok["suspect"].get<bool>()) << ok["reason"];
@@ -502,8 +529,8 @@ TEST(SegmentReal, OneMouseModelSegmentsAnotherMouseHippocampusWithTheDefaults) {
   MRSNAKE_REQUIRE_DATA(labels, "volumes/mouse-brain/mouse2_labels.nii.gz");
   const auto dir = mrsnake::test::scratch_dir("segment-mouse");
   const std::string model = (dir / "hippocampus.model").string();
-  const auto b = mrsnake::test::run_mrsnake("-q build-model --labels " + ref_labels + " --label 1 --image " + ref_image +
-                                            " -o " + model + " --json");
+  const auto b = mrsnake::test::run_mrsnake("-q build-model --labels " + ref_labels + " --label 1 --image " +
+                                            ref_image + " -o " + model + " --json");
   ASSERT_EQ(b.exit_code, 0) << b.output;
   EXPECT_GT(nlohmann::json::parse(b.output)["scale"]["fit_to_label"]["dice"].get<double>(), 0.95);
   const auto s = mrsnake::test::run_mrsnake("-q segment --image " + image + " --model " + model + " -o " +

@@ -63,7 +63,8 @@ void fill_object(Volume& v, Phi phi, float in, float out, int n = 3) {
         for (int a = 0; a < n; ++a)
           for (int b = 0; b < n; ++b)
             for (int c = 0; c < n; ++c) {
-              const auto p = v.index_to_physical(i + (a + 0.5) / n - 0.5, j + (b + 0.5) / n - 0.5, k + (c + 0.5) / n - 0.5);
+              const auto p =
+                  v.index_to_physical(i + (a + 0.5) / n - 0.5, j + (b + 0.5) / n - 0.5, k + (c + 0.5) / n - 0.5);
               inside += phi(Eigen::Vector3d(p[0], p[1], p[2])) < 0;
             }
         const double f = inside / double(n * n * n);
@@ -155,13 +156,13 @@ TEST(Sampler, ValuesAlongALineMatchValueAtEachPoint) {
     int count;
   };
   const std::vector<Line> lines{
-      {at(1.2, 1.7, 1.1), at(6.9, 5.3, 4.8), 0.1, 0.8 / 22, 23},                 // inside
-      {at(1.2, 1.7, 1.1), at(6.9, 5.3, 4.8), 0.9, -0.8 / 22, 23},                // inside, backwards
-      {at(1.2, 1.7, 1.1), at(6.9, 5.3, 4.8), 0.5, 0.1, 1},                       // one point
-      {at(2.2, 3.1, 1.5), at(8.0 - 1e-9, 3.1, 1.5), 0.0, 1.0 / 22, 23},          // up to just below x = n − 1
-      {at(-2.0, 3.5, 2.5), at(10.5, 3.5, 2.5), -0.25, 1.5 / 22, 23},             // through two faces
-      {at(8.0, 2.2, 3.3), at(8.0, 6.1, 5.2), -0.25, 1.5 / 22, 23},               // on the last x plane
-      {at(4.4, 3.3, 2.2), at(4.4, 3.3, 2.2), -0.25, 1.5 / 22, 23}};              // zero direction
+      {at(1.2, 1.7, 1.1), at(6.9, 5.3, 4.8), 0.1, 0.8 / 22, 23},         // inside
+      {at(1.2, 1.7, 1.1), at(6.9, 5.3, 4.8), 0.9, -0.8 / 22, 23},        // inside, backwards
+      {at(1.2, 1.7, 1.1), at(6.9, 5.3, 4.8), 0.5, 0.1, 1},               // one point
+      {at(2.2, 3.1, 1.5), at(8.0 - 1e-9, 3.1, 1.5), 0.0, 1.0 / 22, 23},  // up to just below x = n − 1
+      {at(-2.0, 3.5, 2.5), at(10.5, 3.5, 2.5), -0.25, 1.5 / 22, 23},     // through two faces
+      {at(8.0, 2.2, 3.3), at(8.0, 6.1, 5.2), -0.25, 1.5 / 22, 23},       // on the last x plane
+      {at(4.4, 3.3, 2.2), at(4.4, 3.3, 2.2), -0.25, 1.5 / 22, 23}};      // zero direction
   for (std::size_t l = 0; l < lines.size(); ++l) {
     const Line& line = lines[l];
     const Eigen::Vector3d dir = line.to - line.from;
@@ -271,9 +272,12 @@ TEST(Rasterize, SphereMatchesTheLatticeWithObliqueDirection) {
         const double d = (physical(grid, i, j, k) - centre).norm();
         const bool in = labels.at(i, j, k) > 0.5f;
         count += in;
-        if (d < r_in) wrong += !in;
-        else if (d > r) wrong += in;
-        else ++ambiguous;
+        if (d < r_in)
+          wrong += !in;
+        else if (d > r)
+          wrong += in;
+        else
+          ++ambiguous;
       }
   EXPECT_EQ(wrong, 0);
   EXPECT_LT(ambiguous, 40);
@@ -290,7 +294,8 @@ TEST(Internal, UmbrellaOfARegularPlanarPatchIsZero) {
   const Eigen::Matrix3d R = rotation(40, {1, 1, 0});
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x)
-      V.row(y * n + x) = (R * Eigen::Vector3d(x + 0.5 * y, y * std::sqrt(3.0) / 2, 0) + Eigen::Vector3d(1, 2, 3)).transpose();
+      V.row(y * n + x) =
+          (R * Eigen::Vector3d(x + 0.5 * y, y * std::sqrt(3.0) / 2, 0) + Eigen::Vector3d(1, 2, 3)).transpose();
   const VertexRings rings = build_vertex_rings(grid_faces(n), n * n);
   RowMatrixX3d U;
   umbrella(rings, V, U);
@@ -474,7 +479,8 @@ TEST(Model, MidpointFrameSynthesisFollowsASimilarity) {
     s.rotation = rotation(70, {0, 1, 1});
     s.scale = 0.6;
     s.translation = {1, 2, 3};
-    EXPECT_LT((model.synthesize(j, s.apply(model.levels[j])) - s.apply(model.levels[j + 1])).cwiseAbs().maxCoeff(), 1e-9);
+    EXPECT_LT((model.synthesize(j, s.apply(model.levels[j])) - s.apply(model.levels[j + 1])).cwiseAbs().maxCoeff(),
+              1e-9);
   }
 }
 
@@ -482,7 +488,8 @@ TEST(Initialize, ThresholdClassesMediansFromALatticeSampleMatchTheWholeBox) {
   // A bright ball (2) on a dark background (-1) with noise of sigma 0.5: the two classes'
   // medians are the two intensities, from every voxel of the box or from a lattice sample.
   Volume image = make_grid({48, 48, 48}, {1, 1, 1}, {-23.5, -23.5, -23.5}, Eigen::Matrix3d::Identity());
-  fill_object(image, [](const Eigen::Vector3d& p) { return p.norm() - 12.0; }, 2.0f, -1.0f, 1);
+  fill_object(
+      image, [](const Eigen::Vector3d& p) { return p.norm() - 12.0; }, 2.0f, -1.0f, 1);
   add_noise(image, 0.5f, 5);
   const Volume smooth = downsample_by_two(image);
   const std::array<long, 3> lo{2, 2, 2}, hi{45, 45, 45};
@@ -553,7 +560,8 @@ TEST(Initialize, TargetFitRecoversASimilarity) {
 TEST(Forces, StepEdgeAndProfileFindAPlaneBoundary) {
   // Bright half-space x < 10.3 (blurred by partial volume); vertices on x = 8 with normal +x.
   Volume image = make_grid({32, 16, 16}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
-  fill_object(image, [](const Eigen::Vector3d& p) { return p.x() - 10.3; }, 1.0f, 0.0f, 5);
+  fill_object(
+      image, [](const Eigen::Vector3d& p) { return p.x() - 10.3; }, 1.0f, 0.0f, 5);
   const VolumeSampler s(image);
   RowMatrixX3d V(3, 3), N(3, 3);
   for (int v = 0; v < 3; ++v) {
@@ -590,7 +598,8 @@ struct PlaneStepCase {
 PlaneStepCase plane_step_case(double boundary, double x0, double x1, double range_mm) {
   PlaneStepCase c;
   c.image = make_grid({32, 16, 16}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
-  fill_object(c.image, [boundary](const Eigen::Vector3d& p) { return p.x() - boundary; }, 1.0f, 0.0f, 5);
+  fill_object(
+      c.image, [boundary](const Eigen::Vector3d& p) { return p.x() - boundary; }, 1.0f, 0.0f, 5);
   c.V.row(0) = Eigen::RowVector3d(x0, 6.0, 7.0);
   c.V.row(1) = Eigen::RowVector3d(x1, 8.0, 8.0);
   c.N.row(0) = c.N.row(1) = Eigen::RowVector3d(1, 0, 0);
@@ -695,7 +704,8 @@ TEST(Forces, RingSharingAveragesNoiseButKeepsASharpMatchOfItsOwn) {
   //    ring's evidence brings the offsets closer to the true 1.3 mm.
   const auto clean_plane_image = [] {
     Volume v = make_grid({24, 18, 18}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
-    fill_object(v, [](const Eigen::Vector3d& p) { return p.x() - 10.3; }, 1.0f, 0.0f, 5);
+    fill_object(
+        v, [](const Eigen::Vector3d& p) { return p.x() - 10.3; }, 1.0f, 0.0f, 5);
     return v;
   };
   Volume noisy = clean_plane_image();
@@ -724,7 +734,8 @@ TEST(Forces, RingSharingAveragesNoiseButKeepsASharpMatchOfItsOwn) {
   //    vertex has a sharp match of its own. A fixed weight drags the rows next to the step
   //    towards the other side; the cost-scaled weight keeps each vertex on its own boundary.
   Volume clean = make_grid({24, 18, 18}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
-  fill_object(clean, [](const Eigen::Vector3d& p) { return p.x() - (p.y() < 7.5 ? 10.3 : 12.3); }, 1.0f, 0.0f, 5);
+  fill_object(
+      clean, [](const Eigen::Vector3d& p) { return p.x() - (p.y() < 7.5 ? 10.3 : 12.3); }, 1.0f, 0.0f, 5);
   const VolumeSampler c(clean);
   const SearchResult own = search_step_edges(c, V, N, RegionStats{1.0, 0.0}, alone);
   const SearchResult fixed = search_step_edges(c, V, N, RegionStats{1.0, 0.0}, shared);
@@ -757,10 +768,12 @@ TEST(Appearance, ProfileStepResidualTellsACleanStepFromAWrappedObject) {
   // The profiles learned on the sphere's subdivided icosahedron must tell them apart.
   const auto image_of = [](double shell_mm, std::uint32_t seed) {
     Volume v = make_grid({40, 40, 40}, {1, 1, 1}, {-19.5, -19.5, -19.5}, Eigen::Matrix3d::Identity());
-    fill_object(v, [](const Eigen::Vector3d& p) { return p.norm() - 10.0; }, 1.0f, 0.0f);
+    fill_object(
+        v, [](const Eigen::Vector3d& p) { return p.norm() - 10.0; }, 1.0f, 0.0f);
     if (shell_mm > 0) {
       Volume shell = v;
-      fill_object(shell, [shell_mm](const Eigen::Vector3d& p) { return p.norm() - 10.0 - shell_mm; }, 0.5f, 0.0f);
+      fill_object(
+          shell, [shell_mm](const Eigen::Vector3d& p) { return p.norm() - 10.0 - shell_mm; }, 0.5f, 0.0f);
       for (std::size_t i = 0; i < v.data.size(); ++i) v.data[i] = std::max(v.data[i], shell.data[i]);
     }
     add_noise(v, 0.2f, seed);
@@ -793,7 +806,8 @@ TEST(Appearance, ProfileStepResidualTellsACleanStepFromAWrappedObject) {
 TEST(Appearance, ProfilesCentredOnTheImagesEdgesUndoTheLabelsRounding) {
   const auto sphere_image = [](double radius) {
     Volume v = make_grid({40, 40, 40}, {1, 1, 1}, {-19.5, -19.5, -19.5}, Eigen::Matrix3d::Identity());
-    fill_object(v, [radius](const Eigen::Vector3d& p) { return p.norm() - radius; }, 1.0f, 0.0f, 7);
+    fill_object(
+        v, [radius](const Eigen::Vector3d& p) { return p.norm() - radius; }, 1.0f, 0.0f, 7);
     return v;
   };
   const auto spheres = icosphere_levels(3, 10.0);
@@ -884,7 +898,8 @@ TEST(Appearance, SerializationRoundTripsAndRejectsDamage) {
   // twin (a flag byte after each spacing, the last level on the edges) reads the same profiles.
   {
     const auto seed = [](const char* name) {
-      const auto all = test::read_all(std::filesystem::path(MRSNAKE_SOURCE_DIR) / "tests/fuzz/corpus/model_sections" / name);
+      const auto all =
+          test::read_all(std::filesystem::path(MRSNAKE_SOURCE_DIR) / "tests/fuzz/corpus/model_sections" / name);
       return std::vector<std::uint8_t>(all.begin() + 1, all.end());
     };
     const Appearance old = deserialize_appearance(seed("appearance_two_levels"));
@@ -957,7 +972,8 @@ TEST(Snake, AdversarialTargetsNeverFlipAFace) {
 TEST(Snake, ConvergesOntoASphereInAVolume) {
   Volume image = make_grid({48, 48, 48}, {1, 1, 1}, {0, 0, 0}, Eigen::Matrix3d::Identity());
   const Eigen::Vector3d c(24.2, 23.7, 24.4);
-  fill_object(image, [&](const Eigen::Vector3d& p) { return (p - c).norm() - 14.0; }, 1.0f, 0.0f, 3);
+  fill_object(
+      image, [&](const Eigen::Vector3d& p) { return (p - c).norm() - 14.0; }, 1.0f, 0.0f, 3);
   TriMesh m = icosphere(3, 11.0);
   m.V.rowwise() += c.transpose();
   const VolumeSampler s(image);

@@ -78,7 +78,7 @@ TEST(StructureScale, FaceCountCoversTheAreaWithHalfVoxelEdgesWithinItsBounds) {
   }
   const double expected = area / (std::sqrt(3.0) / 4.0 * 0.5 * 0.5);  // edges of 0.5 for a sampling of 1
   EXPECT_NEAR(default_face_count(surface, 1.0, 16, 1 << 30), expected, 1.0);
-  EXPECT_EQ(default_face_count(surface, 1.0, 1024, 2048), 2048);  // clamped above
+  EXPECT_EQ(default_face_count(surface, 1.0, 1024, 2048), 2048);     // clamped above
   EXPECT_EQ(default_face_count(surface, 100.0, 1024, 32768), 1024);  // and below
   // Degenerate sampling lengths give the cap, never an overflow.
   EXPECT_EQ(default_face_count(surface, 1e-300, 1024, 32768), 32768);

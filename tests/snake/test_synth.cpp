@@ -286,7 +286,8 @@ TEST(Synth, DeformationHasTheRequestedAmplitudeAndRefusesFolding) {
   double largest = 0;
   for (double x = -31.5; x <= 31.5; x += 3)
     for (double y = -31.5; y <= 31.5; y += 3)
-      for (double z = -31.5; z <= 31.5; z += 3) largest = std::max(largest, p.deformation.displacement({x, y, z}).norm());
+      for (double z = -31.5; z <= 31.5; z += 3)
+        largest = std::max(largest, p.deformation.displacement({x, y, z}).norm());
   EXPECT_NEAR(largest, 4.0, 0.4);
   // The analytic Jacobian matches finite differences.
   const Eigen::Vector3d x(3, -2, 5);
@@ -358,8 +359,10 @@ std::string file_bytes(const std::filesystem::path& p) {
 TEST(SynthCli, WritesTheCaseAndRegeneratesItFromParams) {
   const auto dir = test::scratch_dir("synth-cli");
   const auto a = dir / "a", b = dir / "b";
-  auto first = test::run_mrsnake("-q synth --shape blob --size 40 --spacing 1,1,1.2 --pose random --deform 2 --noise rician "
-                                 "--snr 5 --bias 0.2 --seed 17 --json -o " + a.string());
+  auto first = test::run_mrsnake(
+      "-q synth --shape blob --size 40 --spacing 1,1,1.2 --pose random --deform 2 --noise rician "
+      "--snr 5 --bias 0.2 --seed 17 --json -o " +
+      a.string());
   ASSERT_EQ(first.exit_code, 0) << first.output;
   const auto summary = nlohmann::json::parse(first.output);
   EXPECT_GT(summary.at("object_voxels").get<int>(), 1000);
@@ -462,7 +465,8 @@ TEST(SynthFromImage, NoWarpReproducesTheSourceAndAWarpIsExactlyKnown) {
   EXPECT_TRUE(topology_report(warped.truth_mesh).is_closed_genus0());
   // The truth mesh lies on the 0.5 level of the (binary) truth volume.
   double on = 0;
-  for (int v = 0; v < warped.truth_mesh.num_vertices(); ++v) on += trilinear(warped.truth, warped.truth_mesh.V.row(v).transpose());
+  for (int v = 0; v < warped.truth_mesh.num_vertices(); ++v)
+    on += trilinear(warped.truth, warped.truth_mesh.V.row(v).transpose());
   EXPECT_NEAR(on / warped.truth_mesh.num_vertices(), 0.5, 0.05);
   // The pose turns about the object's centroid (physical), so the object stays in view.
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
@@ -483,7 +487,8 @@ TEST(SynthFromImage, RealBrainMriHippocampus) {
   MRSNAKE_REQUIRE_DATA(labels, "volumes/MRIcrop-seg.gipl.gz");
   const auto dir = test::scratch_dir("synth-real");
   auto r = test::run_mrsnake("-q synth --from-image " + image + " --from-labels " + labels +
-                             " --label 4 --deform 3 --pose random --noise rician --snr 8 --seed 3 --json -o " + dir.string());
+                             " --label 4 --deform 3 --pose random --noise rician --snr 8 --seed 3 --json -o " +
+                             dir.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Volume source = read_volume(image), out = read_volume((dir / "image.nii.gz").string());
   EXPECT_EQ(source.size, out.size);
@@ -491,10 +496,12 @@ TEST(SynthFromImage, RealBrainMriHippocampus) {
   EXPECT_GT(nlohmann::json::parse(r.output).at("object_voxels").get<int>(), 500);
   const auto params = nlohmann::json::parse(file_bytes(dir / "params.json"));
   EXPECT_EQ(params.at("source").at("label").get<int>(), 4);
-  auto again = test::run_mrsnake("-q synth --params " + (dir / "params.json").string() + " -o " + (dir / "again").string());
+  auto again =
+      test::run_mrsnake("-q synth --params " + (dir / "params.json").string() + " -o " + (dir / "again").string());
   ASSERT_EQ(again.exit_code, 0) << again.output;
   EXPECT_EQ(out.data, read_volume((dir / "again" / "image.nii.gz").string()).data);
-  EXPECT_EQ(read_volume((dir / "truth.nii.gz").string()).data, read_volume((dir / "again" / "truth.nii.gz").string()).data);
+  EXPECT_EQ(read_volume((dir / "truth.nii.gz").string()).data,
+            read_volume((dir / "again" / "truth.nii.gz").string()).data);
   auto absent = test::run_mrsnake("synth --from-image " + image + " --from-labels " + labels + " --label 77 -o " +
                                   (dir / "absent").string());
   EXPECT_EQ(absent.exit_code, 3) << absent.output;
@@ -531,14 +538,15 @@ TEST(SynthFromImage, ComponentMakesTheTruthOfOnePartOfTheLabel) {
   const auto r = test::run_mrsnake(from + "--component 2 --seed 4 -o " + (dir / "part2").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Volume truth = read_volume((dir / "part2" / "truth.nii.gz").string());
-  EXPECT_EQ(static_cast<std::size_t>(std::count(truth.data.begin(), truth.data.end(), float(kTruthLabel))), small_voxels);
+  EXPECT_EQ(static_cast<std::size_t>(std::count(truth.data.begin(), truth.data.end(), float(kTruthLabel))),
+            small_voxels);
   EXPECT_EQ(truth.at(25, 10, 10), float(kTruthLabel));
   EXPECT_EQ(truth.at(9, 10, 10), 0.0f);
   const auto params = nlohmann::json::parse(file_bytes(dir / "part2" / "params.json"));
   EXPECT_EQ(params.at("source").at("component").get<int>(), 2);
   // Warped, and regenerated from params.json with the same part.
-  const auto warped = test::run_mrsnake(from + "--component 2 --pose random --deform 1.5 --seed 4 -o " +
-                                        (dir / "warped").string());
+  const auto warped =
+      test::run_mrsnake(from + "--component 2 --pose random --deform 1.5 --seed 4 -o " + (dir / "warped").string());
   ASSERT_EQ(warped.exit_code, 0) << warped.output;
   const auto again = test::run_mrsnake("-q synth --params " + (dir / "warped" / "params.json").string() + " -o " +
                                        (dir / "again").string());
@@ -554,7 +562,8 @@ TEST(SynthFromImage, ComponentMakesTheTruthOfOnePartOfTheLabel) {
   EXPECT_EQ(both_truth.at(25, 10, 10), float(kTruthLabel));
   const auto missing = test::run_mrsnake(from + "--component 3 -o " + (dir / "part3").string());
   EXPECT_EQ(missing.exit_code, 3) << missing.output;
-  EXPECT_NE(missing.output.find("label 5 has 2 connected parts, so there is no part 3"), std::string::npos) << missing.output;
+  EXPECT_NE(missing.output.find("label 5 has 2 connected parts, so there is no part 3"), std::string::npos)
+      << missing.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "part3" / "truth.nii.gz"));
   std::filesystem::remove_all(dir);
 }

@@ -11,10 +11,10 @@
 namespace mrsnake {
 
 struct ShrinkWrapOptions {
-  int levels = 4;               ///< 1:4 splits of the icosahedron
+  int levels = 4;  ///< 1:4 splits of the icosahedron
   int iterations_per_level = 30;
-  double attraction = 0.5;      ///< fraction of the way to the closest point per iteration
-  double relaxation = 0.5;      ///< tangential umbrella weight per iteration
+  double attraction = 0.5;  ///< fraction of the way to the closest point per iteration
+  double relaxation = 0.5;  ///< tangential umbrella weight per iteration
 };
 
 struct ShrinkWrapResult {

@@ -95,7 +95,8 @@ inline Hierarchy height_field_fan(int k, int levels) {
 
 /// Every test hierarchy above.
 inline std::vector<Hierarchy> all_hierarchies(int levels) {
-  return {bumpy_sphere(levels), ellipsoid(levels), bumpy_cap(levels), height_field_fan(6, levels), height_field_fan(5, levels)};
+  return {bumpy_sphere(levels), ellipsoid(levels), bumpy_cap(levels), height_field_fan(6, levels),
+          height_field_fan(5, levels)};
 }
 
 inline double max_row_distance(const RowMatrixX3d& A, const RowMatrixX3d& B) {

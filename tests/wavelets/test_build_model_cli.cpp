@@ -63,7 +63,8 @@ TEST(BuildModelCli, BuildsAModelThatModelInfoAccepts) {
   const auto dir = scratch_dir("build-model-cli");
   const std::string labels = write_ellipsoid_labels(dir);
   const std::string model = (dir / "ellipsoid.model").string();
-  const auto built = run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --faces 2048 --json");
+  const auto built =
+      run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --faces 2048 --json");
   ASSERT_EQ(built.exit_code, 0) << built.output;
   const nlohmann::json summary = nlohmann::json::parse(built.output);
   EXPECT_GE(summary["faces"].get<int>(), 1024);
@@ -88,14 +89,15 @@ TEST(BuildModelCli, BuildsAModelThatModelInfoAccepts) {
   const nlohmann::json& scale = m.scale;
   ASSERT_TRUE(scale.is_object());
   const double radius = scale["equivalent_radius_mm"].get<double>();
-  EXPECT_NEAR(4.0 / 3.0 * M_PI * radius * radius * radius, scale["volume_mm3"].get<double>(), 1e-6 * radius * radius * radius);
+  EXPECT_NEAR(4.0 / 3.0 * M_PI * radius * radius * radius, scale["volume_mm3"].get<double>(),
+              1e-6 * radius * radius * radius);
   EXPECT_EQ(scale["finest_voxel_mm"].get<double>(), 1.0);
   EXPECT_LT(radius / 60.0, 1.0);
   EXPECT_EQ(summary["mc_spacing_mm"].get<double>(), 0.0);
   EXPECT_EQ(scale["marching_cubes_spacing_mm"].get<double>(), 0.0);
   EXPECT_EQ(m.remesh_quality["marching_cubes"]["spacing_mm"].get<double>(), 0.0);
   EXPECT_EQ(m.remesh_quality["marching_cubes"]["smoothing_iterations"].get<int>(), 20);
-  EXPECT_EQ(scale["faces"].get<int>(), 2048);  // as given
+  EXPECT_EQ(scale["faces"].get<int>(), 2048);           // as given
   EXPECT_TRUE(scale["reference_margin_mm"].is_null());  // no --image
   // The finest level, rasterized on the label's grid, matches the label.
   EXPECT_GT(scale["fit_to_label"]["dice"].get<double>(), 0.95);
@@ -127,12 +129,13 @@ TEST(BuildModelCli, BuildsAModelThatModelInfoAccepts) {
 TEST(BuildModelCli, McSpacingZeroUsesTheVoxelSurface) {
   const auto dir = scratch_dir("build-model-cli-spacing");
   const std::string labels = write_ellipsoid_labels(dir);
-  const auto mc = run_mrsnake("-q mc --labels " + labels + " --label 3 -o " + (dir / "voxels.vtp").string() + " --json");
+  const auto mc =
+      run_mrsnake("-q mc --labels " + labels + " --label 3 -o " + (dir / "voxels.vtp").string() + " --json");
   ASSERT_EQ(mc.exit_code, 0) << mc.output;
   const int voxel_faces = nlohmann::json::parse(mc.output)["faces"].get<int>();
   const auto run = [&](const std::string& spacing) {
-    const auto r = run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + (dir / ("m" + spacing)).string() +
-                               " --faces 2048 --mc-spacing " + spacing + " --json");
+    const auto r = run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " +
+                               (dir / ("m" + spacing)).string() + " --faces 2048 --mc-spacing " + spacing + " --json");
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return nlohmann::json::parse(r.output);
   };
@@ -140,9 +143,10 @@ TEST(BuildModelCli, McSpacingZeroUsesTheVoxelSurface) {
   const int coarse = run("2")["input_faces"].get<int>();
   EXPECT_LT(coarse * 2, voxel_faces);
   EXPECT_GT(coarse, 200);
-  EXPECT_EQ(run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + (dir / "bad").string() + " --mc-spacing -1")
-                .exit_code,
-            2);
+  EXPECT_EQ(
+      run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + (dir / "bad").string() + " --mc-spacing -1")
+          .exit_code,
+      2);
 
   // A coarse image is not resampled: by default its voxels' own surface is used.
   Volume coarse_grid = read_volume(labels);
@@ -167,11 +171,14 @@ TEST(BuildModelCli, BadInputsGetExitCodes) {
   const auto absent = run_mrsnake("-q build-model --labels " + labels + " --label 9 -o " + model);
   EXPECT_EQ(absent.exit_code, 3) << absent.output;
   EXPECT_FALSE(std::filesystem::exists(model));
-  EXPECT_EQ(run_mrsnake("-q build-model --labels " + (dir / "none.nii.gz").string() + " --label 3 -o " + model).exit_code, 3);
-  EXPECT_EQ(run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --predict cubic").exit_code, 2);
-  EXPECT_EQ(run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --levels 3 --faces 100").exit_code, 2);
-  expect_refused("--labels " + labels + " --label 3 -o " + model + " --image " + labels +
-                     " --profile-alignment middle",
+  EXPECT_EQ(
+      run_mrsnake("-q build-model --labels " + (dir / "none.nii.gz").string() + " --label 3 -o " + model).exit_code, 3);
+  EXPECT_EQ(run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --predict cubic").exit_code,
+            2);
+  EXPECT_EQ(
+      run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --levels 3 --faces 100").exit_code,
+      2);
+  expect_refused("--labels " + labels + " --label 3 -o " + model + " --image " + labels + " --profile-alignment middle",
                  2, "--profile-alignment", model);
   expect_refused("--labels " + labels + " --label 3 -o " + model + " --profile-alignment edges", 2, "--image", model);
 }
@@ -186,7 +193,8 @@ TEST(BuildModelCli, ProfileAlignmentIsChosenAndReported) {
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return nlohmann::json::parse(r.output)["profile_alignment"];
   };
-  const nlohmann::json automatic = summary_of("auto.model", ""), labels_kept = summary_of("labels.model", " --profile-alignment labels");
+  const nlohmann::json automatic = summary_of("auto.model", ""),
+                       labels_kept = summary_of("labels.model", " --profile-alignment labels");
   EXPECT_EQ(automatic["centred_on"], "edges");
   EXPECT_GE(automatic["levels_aligned"].get<int>(), 1);
   EXPECT_GT(automatic["mean_abs_shift_mm"].get<double>(), 0.0);
@@ -232,8 +240,9 @@ TEST(BuildModelCli, CloseTunnelsMakesAGenusOneLabelModelable) {
   const auto refused =
       run_mrsnake("-q build-model --labels " + labels + " --label 4 -o " + model + " --faces 2048 --close-tunnels 0");
   EXPECT_EQ(refused.exit_code, 3) << refused.output;
-  EXPECT_NE(refused.output.find("genus-1 surface (tunnels through it), but a model needs genus 0; drop --close-tunnels 0 "),
-            std::string::npos)
+  EXPECT_NE(
+      refused.output.find("genus-1 surface (tunnels through it), but a model needs genus 0; drop --close-tunnels 0 "),
+      std::string::npos)
       << refused.output;
   // The default closes tunnels up to 3 voxels: this hole is wider, and it says so.
   expect_refused("--labels " + labels + " --label 4 -o " + model + " --faces 2048", 3,
@@ -243,8 +252,8 @@ TEST(BuildModelCli, CloseTunnelsMakesAGenusOneLabelModelable) {
   expect_refused("--labels " + labels + " --label 4 -o " + model + " --faces 2048 --close-tunnels 1", 3,
                  "try a larger --close-tunnels", model);
 
-  const auto built =
-      run_mrsnake("-q build-model --labels " + labels + " --label 4 -o " + model + " --faces 2048 --close-tunnels 6 --json");
+  const auto built = run_mrsnake("-q build-model --labels " + labels + " --label 4 -o " + model +
+                                 " --faces 2048 --close-tunnels 6 --json");
   ASSERT_EQ(built.exit_code, 0) << built.output;
   // The repair is announced (a warning on stderr, before the JSON on stdout).
   EXPECT_NE(built.output.find("closed its tunnels"), std::string::npos) << built.output;
@@ -260,10 +269,11 @@ namespace {
 /// A capsule of label 1 along x: radius `radius` voxels, `length` voxels between the centres of
 /// its caps, in a grid 20 voxels longer and 24 voxels across.
 std::string write_tube_labels(const std::filesystem::path& dir, int length, double radius) {
-  const Volume v = labels_where({static_cast<std::size_t>(length) + 20, 24, 24}, 1.0f, [&](double i, double j, double k) {
-    const double x = i - std::clamp(i, 10.0, 10.0 + length), y = j - 11.5, z = k - 11.5;
-    return x * x + y * y + z * z <= radius * radius;
-  });
+  const Volume v =
+      labels_where({static_cast<std::size_t>(length) + 20, 24, 24}, 1.0f, [&](double i, double j, double k) {
+        const double x = i - std::clamp(i, 10.0, 10.0 + length), y = j - 11.5, z = k - 11.5;
+        return x * x + y * y + z * z <= radius * radius;
+      });
   const std::string path = (dir / ("tube" + std::to_string(length) + ".nii.gz")).string();
   write_volume(path, v, VoxelType::uint8);
   return path;
@@ -278,8 +288,8 @@ TEST(BuildModelCli, LongTubesArePuncturedInTheMiddleAndTheTooLongMappedHierarchi
   // is built on the hierarchical map, with no flipped triangle at any level.
   const auto dir = scratch_dir("build-model-cli-tube");
   const std::string model = (dir / "tube.model").string();
-  const auto built = run_mrsnake("-q build-model --labels " + write_tube_labels(dir, 70, 2.5) + " --label 1 -o " + model +
-                                 " --faces 2048 --mc-spacing 1.2 --json");
+  const auto built = run_mrsnake("-q build-model --labels " + write_tube_labels(dir, 70, 2.5) + " --label 1 -o " +
+                                 model + " --faces 2048 --mc-spacing 1.2 --json");
   ASSERT_EQ(built.exit_code, 0) << built.output;
   const auto summary = nlohmann::json::parse(built.output);
   EXPECT_EQ(summary["faces"], 2048);
@@ -313,8 +323,9 @@ TEST(BuildModelCli, ComponentModelsOnePartOfALabelAndRecordsIt) {
   const std::string whole = (dir / "whole.model").string();
   const auto w = run_mrsnake("build-model --labels " + labels + " --label 3 -o " + whole + " --faces 512");
   ASSERT_EQ(w.exit_code, 0) << w.output;
-  EXPECT_NE(w.output.find("2 connected surfaces; the model uses the largest (--component K models the K-th largest part"),
-            std::string::npos)
+  EXPECT_NE(
+      w.output.find("2 connected surfaces; the model uses the largest (--component K models the K-th largest part"),
+      std::string::npos)
       << w.output;
   EXPECT_FALSE(load_model(whole, {true}).source_component.has_value());
 
@@ -332,7 +343,8 @@ TEST(BuildModelCli, ComponentModelsOnePartOfALabelAndRecordsIt) {
     const double radius = (m.level_positions.back().rowwise() - centre).rowwise().norm().mean();
     EXPECT_NEAR(radius, part == 1 ? 7.0 : 5.0, 0.6);
     const auto info = run_mrsnake("model-info " + model);
-    EXPECT_NE(info.output.find("label 3, its part " + std::to_string(part) + " by size"), std::string::npos) << info.output;
+    EXPECT_NE(info.output.find("label 3, its part " + std::to_string(part) + " by size"), std::string::npos)
+        << info.output;
   }
   expect_refused("--labels " + labels + " --label 3 --component 3 -o " + (dir / "part3.model").string(), 3,
                  "label 3 has 2 connected parts, so there is no part 3; give --component 1 to 2",
@@ -355,13 +367,14 @@ TEST(BuildModelCli, AModelThatLostItsOrganIsRefusedUnlessAllowed) {
   const std::string model = (dir / "ball.model").string();
   expect_refused("--labels " + labels + " --label 1 -o " + model + " --mc-spacing 1.2", 5,
                  "the model's finest level covers its label with Dice ", model);
-  const auto refused = run_mrsnake("-q build-model --labels " + labels + " --label 1 -o " + model + " --mc-spacing 1.2");
+  const auto refused =
+      run_mrsnake("-q build-model --labels " + labels + " --label 1 -o " + model + " --mc-spacing 1.2");
   EXPECT_NE(refused.output.find("give a smaller --mc-spacing (e.g. 0.15)"), std::string::npos) << refused.output;
   EXPECT_NE(refused.output.find("--allow-poor-fit"), std::string::npos) << refused.output;
 
   // Allowed: written, with a warning and the fit in model.json.
-  const auto allowed =
-      run_mrsnake("-q build-model --labels " + labels + " --label 1 -o " + model + " --mc-spacing 1.2 --allow-poor-fit");
+  const auto allowed = run_mrsnake("-q build-model --labels " + labels + " --label 1 -o " + model +
+                                   " --mc-spacing 1.2 --allow-poor-fit");
   ASSERT_EQ(allowed.exit_code, 0) << allowed.output;
   EXPECT_NE(allowed.output.find("warning: the model's finest level covers its label with Dice "), std::string::npos)
       << allowed.output;

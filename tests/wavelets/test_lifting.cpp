@@ -84,7 +84,8 @@ TEST(Lifting, LocalDetailsFollowASimilarityOfTheCoarseLevel) {
       const WaveletAnalysis a = wt.analyze(h.finest);
       const RowMatrixX3d moved_fine = move(h.finest);
       const RowMatrixX3d S = wt.synthesize(move(a.base), a.details);
-      EXPECT_LE(max_row_distance(S, moved_fine), 1e-9 * bounding_box_diagonal(moved_fine)) << h.name << " " << to_string(p);
+      EXPECT_LE(max_row_distance(S, moved_fine), 1e-9 * bounding_box_diagonal(moved_fine))
+          << h.name << " " << to_string(p);
       for (const DetailStats& st : a.stats) EXPECT_EQ(st.degenerate_frames, 0) << h.name;
 
       // The same test fails with global details: the check can tell them apart.
@@ -193,7 +194,7 @@ TEST(Lifting, StencilsAreAffineAndFollowTheRules) {
       }
     }
   EXPECT_EQ(four_point, 6 + 12);  // boundary edges of levels 0 and 1
-  EXPECT_EQ(center, 6);  // level-0 spokes (the center and the boundary); level 1 spokes are 10-point
+  EXPECT_EQ(center, 6);           // level-0 spokes (the center and the boundary); level 1 spokes are 10-point
   EXPECT_GT(ten_point, 0);
 }
 

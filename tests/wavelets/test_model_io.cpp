@@ -146,7 +146,8 @@ TEST(ModelIo, EveryDamageGetsASpecificError) {
     auto b = read_all(dir / "details.bin");
     b[b.size() / 2] ^= 0x01;
     write_all(dir / "details.bin", b);
-    rewrite_manifest(dir, [&](nlohmann::json& j) { j["files"]["details"]["fnv1a64"] = hex(fnv1a64(b.data(), b.size())); });
+    rewrite_manifest(dir,
+                     [&](nlohmann::json& j) { j["files"]["details"]["fnv1a64"] = hex(fnv1a64(b.data(), b.size())); });
     expect_input_error(dir, "its checksum does not match");
   }
   {  // an altered level mesh
@@ -185,7 +186,8 @@ TEST(ModelIo, EveryDamageGetsASpecificError) {
     const std::uint64_t sum = fnv1a64(b.data(), b.size() - 8);
     for (int i = 0; i < 8; ++i) b[b.size() - 8 + i] = static_cast<std::uint8_t>(sum >> (8 * i));
     write_all(dir / "details.bin", b);
-    rewrite_manifest(dir, [&](nlohmann::json& j) { j["files"]["details"]["fnv1a64"] = hex(fnv1a64(b.data(), b.size())); });
+    rewrite_manifest(dir,
+                     [&](nlohmann::json& j) { j["files"]["details"]["fnv1a64"] = hex(fnv1a64(b.data(), b.size())); });
     expect_input_error(dir, "details.bin' of model");
     expect_input_error(dir, "has format version 2, newer");
   }
