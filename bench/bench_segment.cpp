@@ -1,4 +1,4 @@
-// Segmentation benchmark (issue 6): mrsnake segment against ITK's geodesic active contour
+// Segmentation benchmark: mrsnake segment against ITK's geodesic active contour
 // and threshold level sets, each started from the snake's own initial surface, on
 // synthetic cases (mrsnake synth) or on real images warped by a known deformation
 // (synth --from-image). One table: Dice, ASSD, HD95, seconds of compute after loading,

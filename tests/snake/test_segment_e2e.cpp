@@ -359,11 +359,11 @@ TEST(SegmentCommand, SynthBuildModelWithImageThenSegment) {
 }
 
 TEST(SegmentReal, LiverOfTheAbdomenCtReachesDice09WithoutSelfIntersections) {
-  // Issue 6's real-data procedure on the liver (label 5) of the 30-slice CT: the model from
-  // the labels (tunnels closed) with the image's appearance, a new case warped by a known
-  // random pose and a 6 mm deformation (bench/real_data.sh's seed), the snake from the fit.
-  // Before the snake kept the model's tangential sampling and filtered its profile
-  // targets, it ended at Dice 0.80 with 1637 self-intersections from a start of 0.97.
+  // The real-data procedure (bench/real_data.sh) on the liver (label 5) of the 30-slice CT:
+  // the model from the labels (tunnels closed) with the image's appearance, a new case warped
+  // by a known random pose and a 6 mm deformation (bench/real_data.sh's seed), the snake from
+  // the fit. It needs the snake to keep the model's tangential sampling and to filter its
+  // profile targets: without them it ends at Dice 0.80 with 1637 self-intersections.
   MRSNAKE_REQUIRE_DATA(image, "volumes/abdomen-ct-small.nii.gz");
   MRSNAKE_REQUIRE_DATA(labels, "volumes/abdomen-ct-small-seg.nii.gz");
   const auto dir = mrsnake::test::scratch_dir("segment-real-liver");
