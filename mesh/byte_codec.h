@@ -15,24 +15,12 @@
 namespace mrsnake {
 
 namespace byte_codec_detail {
-template <std::size_t N>
-struct Unsigned;
-template <>
-struct Unsigned<1> {
-  using type = std::uint8_t;
-};
-template <>
-struct Unsigned<2> {
-  using type = std::uint16_t;
-};
-template <>
-struct Unsigned<4> {
-  using type = std::uint32_t;
-};
-template <>
-struct Unsigned<8> {
-  using type = std::uint64_t;
-};
+/// The unsigned integer of T's size, whose shifts give T's bytes in order.
+template <class T>
+using UnsignedOf =
+    std::conditional_t<sizeof(T) == 1, std::uint8_t,
+                       std::conditional_t<sizeof(T) == 2, std::uint16_t,
+                                          std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t>>>;
 }  // namespace byte_codec_detail
 
 /// Appends values little-endian.
@@ -41,11 +29,11 @@ class ByteWriter {
   /// Starts with `prefix` (e.g. a magic string's bytes).
   explicit ByteWriter(std::vector<std::uint8_t> prefix = {}) : bytes_(std::move(prefix)) {}
 
-  /// \pre T is an arithmetic type.
+  /// \pre T is an arithmetic type of at most 8 bytes.
   template <class T>
   void put(T value) {
-    static_assert(std::is_arithmetic_v<T>, "only numbers have a byte encoding");
-    typename byte_codec_detail::Unsigned<sizeof(T)>::type bits;
+    static_assert(std::is_arithmetic_v<T> && sizeof(T) <= 8, "only numbers have a byte encoding");
+    byte_codec_detail::UnsignedOf<T> bits;
     std::memcpy(&bits, &value, sizeof(T));
     for (std::size_t i = 0; i < sizeof(T); ++i) bytes_.push_back(static_cast<std::uint8_t>(bits >> (8 * i)));
   }
@@ -64,13 +52,13 @@ class ByteReader {
   ByteReader(const std::vector<std::uint8_t>& bytes, std::size_t position, std::string truncated_message)
       : bytes_(bytes), position_(position), truncated_message_(std::move(truncated_message)) {}
 
-  /// \pre T is an arithmetic type.
+  /// \pre T is an arithmetic type of at most 8 bytes.
   /// \throw InputError if fewer than sizeof(T) bytes are left.
   template <class T>
   T get() {
-    static_assert(std::is_arithmetic_v<T>, "only numbers have a byte encoding");
+    static_assert(std::is_arithmetic_v<T> && sizeof(T) <= 8, "only numbers have a byte encoding");
     if (position_ + sizeof(T) > bytes_.size()) throw InputError(truncated_message_);
-    typename byte_codec_detail::Unsigned<sizeof(T)>::type bits = 0;
+    byte_codec_detail::UnsignedOf<T> bits = 0;
     for (std::size_t i = 0; i < sizeof(T); ++i)
       bits |= static_cast<decltype(bits)>(static_cast<decltype(bits)>(bytes_[position_ + i]) << (8 * i));
     position_ += sizeof(T);
