@@ -58,7 +58,7 @@ void add_quality_command(CLI::App& app) {
                   "Reference mesh: adds the symmetric surface distance (mean, RMS, Hausdorff)");
   cmd->add_option("--samples", *samples, "Random points per face for the distance, on top of every vertex")
       ->check(CLI::Range(0, 100000));
-  cmd->add_flag("--json", *json, "Print JSON instead of text (keys: see README, 'Quality JSON keys')");
+  cmd->add_flag("--json", *json, "Print JSON instead of text (keys: docs/report-keys.md)");
   cmd->footer("Example: mrsnake quality out/level_4.vtp --reference liver.vtp --json");
   cmd->callback([=] {
     const TriMesh mesh = read_mesh(*mesh_path);

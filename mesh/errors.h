@@ -8,7 +8,7 @@
 
 namespace mrsnake {
 
-/// Exit codes of the `mrsnake` command (documented in the README).
+/// Exit codes of the `mrsnake` command (documented in docs/exit-codes.md).
 enum class ExitCode : int {
   success = 0,
   internal = 1,     ///< a bug: an unexpected exception

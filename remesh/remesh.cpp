@@ -101,12 +101,13 @@ SizingFields sizing_fields(const TriMesh& surface, const RemeshOptions& options,
   // Below that, the curvature sizing alone spreads the base: the bound moved base vertices
   // onto small bent features such as a bear's ears (Q mean -0.013 at 16k faces).
   if (options.levels != 0 || levels == 1 || bound_points <= 0.5 * n0) return s;
-  // Once: a base 16x larger left a hierarchy of two levels with 10 % irregular vertices (the
+  // Once: a base 16x larger leaves a hierarchy of two levels with 10 % irregular vertices (the
   // octopus at 16k faces), and a marching-cubes staircase's voxel steps, which the curvature
-  // measure sees as bends, asked for it too (the liver).
+  // measure sees as bends, ask for it too (the liver).
   n0 = 4 * n0 - 6;
   --levels;
-  const Eigen::VectorXd bounded = bend_bounded_density(surface, s.base_density, bend_kappa, n0, max_bend);
+  const Eigen::VectorXd grown_kappa = smooth_vertex_field(surface, kappa, base_spacing_rings(surface, n0));
+  const Eigen::VectorXd bounded = bend_bounded_density(surface, s.base_density, grown_kappa, n0, max_bend);
   s.wanted = s.wanted.cwiseProduct(bounded.cwiseQuotient(s.base_density));
   s.base_density = bounded;
   return s;

@@ -56,15 +56,16 @@ struct RemeshOptions {
   /// Base vertices are spread by farthest-point sampling with squared distances scaled by
   /// w^base_density_exponent (w: the curvature sizing's wanted density): more base vertices,
   /// and so more irregular ones, where the surface bends, which they absorb. 0 = even in 3D.
-  /// 1: RMS -20 % on the bear (now below CGAL's at 16k faces), -7 % on blobby 16k.
+  /// 1 against 0: RMS -20 % on the bear (below CGAL's at 16k faces), -7 % on blobby 16k.
   double base_density_exponent = 1.0;
-  /// Where a base spread by the curvature sizing alone would cut off tips, bends and thin
-  /// tubes, the base grows until no base edge need turn the surface's normal by much more than
-  /// this (radians; remesh/sizing.h): when that bound asks for more than half of the base, the
-  /// base grows 4x, once (the hierarchy has one level less), and is spread by the bound.
-  /// 2: on horse, armadillo, human and the lateral ventricles at 16k faces, Hausdorff 2.5, 5.8,
-  /// 1.6 and 1.2 % fell to 0.46, 1.0, 0.73 and 0.56 %, and Q mean rose by 0.03 to 0.12; the
-  /// price is interior valence 6 at ~98 % instead of 99 % where the base grows. 0 = off.
+  /// The bend bound (remesh/sizing.h): no base edge should turn the surface's normal by much
+  /// more than this (radians). Where the bound asks for more than half of the base, as a base
+  /// spread by the curvature sizing alone would cut off tips, bends and thin tubes, the base
+  /// grows 4x, once (the hierarchy has one level less), and is spread by the bound. Not with
+  /// `levels` given, nor for a hierarchy of one level. 2 against 0: on horse, armadillo, human
+  /// and the lateral ventricles at 16k faces, Hausdorff 2.5, 5.8, 1.6 and 1.2 % fell to 0.46,
+  /// 1.0, 0.73 and 0.56 %, and Q mean rose by 0.03 to 0.12; the price is interior valence 6 at
+  /// ~98 % instead of 99 % where the base grows. 0 = off.
   double max_base_bend = 2.0;
   /// Passes of 1-ring averaging of that density first; -1 = about one base spacing,
   /// round(sqrt(input vertices / n0)). 3: without it the liver's base followed voxel steps
@@ -75,7 +76,7 @@ struct RemeshOptions {
   /// With all_vertices: iterations per level of tangential smoothing toward equilateral 3D
   /// triangles, moved in D (remesh/shape_smoothing.h). The Lloyd step evens out sizes but is
   /// affine invariant, so it cannot repair shear; this can. 0 = the Lloyd step alone.
-  /// 6 (was 3): Q mean +0.01 on every bench input at ~+2 % RMS (docs/bench-remesh.md).
+  /// 6 against 3: Q mean +0.01 on every bench input at ~+2 % RMS (docs/bench-remesh.md).
   int shape_iterations = 6;
   /// With all_vertices: iterations per level of tangential relaxation on the surface after the
   /// Lloyd and shape rounds (remesh/shape_smoothing.h, SmoothingTarget::area_centroid): each vertex
@@ -93,7 +94,7 @@ struct RemeshOptions {
   /// (remesh/triangle_repair.h): vertices of triangles with Q < repair_threshold move
   /// tangentially, on the input, only when that raises the smallest Q around them. 0 = off.
   int repair_sweeps = 6;
-  /// 0.85 (was 0.8): Q mean +0.005 to +0.01; 0.9 pushed the heart's Hausdorff past 0.5 %.
+  /// 0.85 against 0.8: Q mean +0.005 to +0.01; 0.9 pushed the heart's Hausdorff past 0.5 %.
   double repair_threshold = 0.85;
   /// Repair every level (true) or only the finest (false; coarse levels keep the Lloyd layout).
   bool repair_coarse_levels = true;

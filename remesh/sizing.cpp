@@ -73,7 +73,8 @@ double bend_bound_points(const TriMesh& mesh, const Eigen::VectorXd& curvature, 
 Eigen::VectorXd bend_bounded_density(const TriMesh& mesh, const Eigen::VectorXd& density,
                                      const Eigen::VectorXd& curvature, double points, double max_bend) {
   const Eigen::VectorXd area = vertex_areas(mesh);
-  const Eigen::VectorXd floor = bend_bound(curvature, max_bend);
+  Eigen::VectorXd floor = bend_bound(curvature, max_bend);
+  if (const double floor_points = area.dot(floor); floor_points > 0.5 * points) floor *= 0.5 * points / floor_points;
   // Scale t of the density (points per area = t·density where the bound is slack) such that
   // Σ area·max(t·density, floor) = points; the count grows with t, so bisect.
   const auto count = [&](double t) { return area.dot((t * density).cwiseMax(floor)); };
@@ -82,8 +83,8 @@ Eigen::VectorXd bend_bounded_density(const TriMesh& mesh, const Eigen::VectorXd&
     const double mid = 0.5 * (lo + hi);
     (count(mid) < points ? lo : hi) = mid;
   }
-  const double t = std::max(hi, 1e-12 * points / area.dot(density));
-  return density.cwiseMax(floor / t);
+  // t >= points / (2 Σ area·density) > 0: the bound takes at most half of the points.
+  return density.cwiseMax(floor / hi);
 }
 
 }  // namespace mrsnake

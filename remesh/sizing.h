@@ -28,7 +28,9 @@ Eigen::VectorXd vertex_areas(const TriMesh& mesh);
 /// surface's normal by more than about max_bend radians: a tube of radius r then gets at least
 /// about 2π·0.64 / max_bend points around (curvature() of a tube is ~0.64 / r). The result is
 /// the density where the bound is slack and the bound where it is not, in the same units.
-/// \pre density, curvature have one entry per vertex; points > 0; max_bend > 0.
+/// Where the bound alone would take more than half of the points, it is scaled down to half
+/// (a wider bend than max_bend), so that the rest still follow the density.
+/// \pre density (> 0), curvature have one entry per vertex; points > 0; max_bend > 0.
 Eigen::VectorXd bend_bounded_density(const TriMesh& mesh, const Eigen::VectorXd& density,
                                      const Eigen::VectorXd& curvature, double points, double max_bend);
 

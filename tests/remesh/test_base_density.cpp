@@ -62,25 +62,29 @@ TEST(Sizing, TheBendBoundOnASphereAsksForItsAreaOverTheSpacingSquared) {
   }
 }
 
-// Curvature φ on the x > 0 half only, density 1 everywhere. Where the bound is slack the
+// Curvature φ on the cap x > 0.5 only (a quarter of the area), density 1 everywhere. Where the bound is slack the
 // density comes back unchanged. Where it is not, the bent half gets the bound's own density,
 // with the scale t of the rest set so that Σ area·max(t·1, floor) is the points asked for.
+// Where the bound alone would take more than half of the points, it is scaled to half.
 TEST(Sizing, TheBendBoundRaisesTheDensityOnlyWhereItIsTight) {
   const TriMesh sphere = icosphere(3);
   const int n = sphere.num_vertices();
   const Eigen::VectorXd area = vertex_areas(sphere);
   Eigen::VectorXd kappa = Eigen::VectorXd::Zero(n);
   for (int v = 0; v < n; ++v)
-    if (sphere.V(v, 0) > 0) kappa[v] = 3.0;
+    if (sphere.V(v, 0) > 0.5) kappa[v] = 3.0;
   const Eigen::VectorXd ones = Eigen::VectorXd::Ones(n);
   const double bound = bend_bound_points(sphere, kappa, 1.0);
   EXPECT_TRUE(bend_bounded_density(sphere, ones, kappa, 100 * bound, 1.0) == ones);
 
-  const double points = 1.5 * bound;
-  const Eigen::VectorXd raised = bend_bounded_density(sphere, ones, kappa, points, 1.0);
-  const double floor = 2.0 / std::sqrt(3.0) * 9.0, bent_area = area.dot((kappa.array() > 0).cast<double>().matrix());
-  const double t = (points - bent_area * floor) / (area.sum() - bent_area);
-  for (int v = 0; v < n; ++v) EXPECT_NEAR(raised[v], kappa[v] > 0 ? floor / t : 1.0, 1e-6 * floor / t) << v;
+  const double bent_area = area.dot((kappa.array() > 0).cast<double>().matrix());
+  for (const double points : {3.0 * bound, 1.0 * bound}) {
+    const Eigen::VectorXd raised = bend_bounded_density(sphere, ones, kappa, points, 1.0);
+    const double floor = 2.0 / std::sqrt(3.0) * 9.0 * std::min(1.0, 0.5 * points / bound);
+    const double t = (points - bent_area * floor) / (area.sum() - bent_area);
+    for (int v = 0; v < n; ++v)
+      EXPECT_NEAR(raised[v], kappa[v] > 0 ? floor / t : 1.0, 1e-6 * floor / t) << points << " " << v;
+  }
 }
 
 // Averaging keeps a constant field, spreads a spike to its neighbours and never leaves the

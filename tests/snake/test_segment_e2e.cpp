@@ -384,8 +384,8 @@ TEST(SegmentReal, LiverOfTheAbdomenCtReachesDice09WithoutSelfIntersections) {
     const nlohmann::json rep = nlohmann::json::parse(s.output);
     EXPECT_EQ(rep["self_intersections"], 0);
     // The finest level's edges (~2.3 mm) are below the 3 mm voxels: synthesized, not deformed.
-    const std::size_t finest = rep["levels"].size() - 1;
-    ASSERT_GE(finest, 3u);
+    const int finest = static_cast<int>(rep["levels"].size()) - 1;
+    ASSERT_GE(finest, 3);
     EXPECT_FALSE(rep["levels"][finest]["deformed"].get<bool>());
     EXPECT_EQ(rep["levels"][finest]["iterations"], 0);
     EXPECT_TRUE(rep["levels"][finest - 1]["deformed"].get<bool>());
