@@ -77,7 +77,7 @@ struct SizingFields {
 
 // Curvature sizing. Where the bend bound (remesh/sizing.h) asks for more than half of the base
 // vertices (thin tubes, many tips), the base grows 4x and the hierarchy loses a level, unless
-// the levels were given; the base is then spread by the bound, and the
+// the levels were given or there is only one. The grown base is spread by the bound, and the
 // relaxation's density raised by the same factor, so that the levels keep the base's grading.
 SizingFields sizing_fields(const TriMesh& surface, const RemeshOptions& options, int& levels, int& n0) {
   const int n = surface.num_vertices();
