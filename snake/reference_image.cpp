@@ -109,9 +109,10 @@ Volume deserialize_reference_image(const std::vector<std::uint8_t>& bytes) {
   const std::size_t expected = kHeaderBytes + 4 * v.num_voxels() + 8;
   if (bytes.size() < expected) throw defect("is truncated");
   if (bytes.size() > expected) throw defect("has trailing bytes");
-  std::uint64_t stored;
-  stored = ByteReader(bytes, expected - 8, "").get<std::uint64_t>();
-  if (stored != fnv1a64(bytes.data(), expected - 8))
+  // The header reader stands at the voxels (kHeaderBytes); the checksum follows them.
+  v.data.resize(v.num_voxels());
+  for (float& x : v.data) x = r.get<float>();
+  if (r.get<std::uint64_t>() != fnv1a64(bytes.data(), expected - 8))
     throw defect("was altered or corrupted (its checksum does not match)");
   for (int a = 0; a < 3; ++a)
     // Bounds far beyond any scanner's (µm to m voxels, km away) keep index arithmetic finite.
@@ -125,9 +126,6 @@ Volume deserialize_reference_image(const std::vector<std::uint8_t>& bytes) {
       if (!(std::abs(dot - (a == b ? 1.0 : 0.0)) < 1e-6))
         throw defect("has a direction matrix that is not orthonormal");
     }
-  v.data.resize(v.num_voxels());
-  ByteReader voxels(bytes, kHeaderBytes, defect("is truncated").what());
-  for (float& x : v.data) x = voxels.get<float>();
   for (float x : v.data)
     if (!std::isfinite(x)) throw defect("holds non-finite values");
   return v;
