@@ -1,4 +1,4 @@
-// mrsnake evaluate: scores a segmentation against a truth (see snake/evaluate.h).
+// mrsnake evaluate: scores a segmentation against a truth (see evaluation/evaluate.h).
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -9,7 +9,7 @@
 #include "mesh/errors.h"
 #include "mesh/image_io.h"
 #include "mesh/mesh_io.h"
-#include "snake/evaluate.h"
+#include "evaluation/evaluate.h"
 
 namespace mrsnake::cli {
 

@@ -7,9 +7,10 @@
 #include "apps/cli.h"
 #include "mesh/errors.h"
 #include "snake/appearance.h"
-#include "snake/model_bridge.h"
+#include "model/snake_adapter.h"
 #include "snake/reference_image.h"
-#include "wavelets/model_io.h"
+#include "model/model_io.h"
+#include "model/sections.h"
 
 namespace mrsnake::cli {
 namespace {

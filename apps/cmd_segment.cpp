@@ -30,11 +30,11 @@
 #include "mesh/marching_cubes.h"
 #include "mesh/mesh_io.h"
 #include "mesh/parallel.h"
-#include "snake/evaluate.h"
-#include "snake/model_bridge.h"
+#include "evaluation/evaluate.h"
+#include "model/snake_adapter.h"
 #include "snake/rasterize.h"
 #include "snake/segment.h"
-#include "wavelets/model_io.h"
+#include "model/model_io.h"
 
 namespace mrsnake::cli {
 

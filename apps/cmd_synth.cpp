@@ -1,4 +1,4 @@
-// mrsnake synth: synthetic volumes with an exactly known truth (see snake/synth.h).
+// mrsnake synth: synthetic volumes with an exactly known truth (see phantoms/synth.h).
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -12,7 +12,7 @@
 #include "mesh/label_repair.h"
 #include "mesh/mesh_io.h"
 #include "mesh/topology.h"
-#include "snake/synth.h"
+#include "phantoms/synth.h"
 
 namespace mrsnake::cli {
 namespace {

@@ -47,7 +47,7 @@
 #include "mesh/atomic_file.h"
 #include "mesh/image_io.h"
 #include "mesh/label_repair.h"
-#include "snake/evaluate.h"
+#include "evaluation/evaluate.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;

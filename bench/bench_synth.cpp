@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "snake/synth.h"
+#include "phantoms/synth.h"
 
 int main(int argc, char** argv) {
   using namespace mrsnake;

@@ -14,7 +14,7 @@
 
 #include "mesh/subdivision.h"
 #include "wavelets/lifting.h"
-#include "wavelets/model_io.h"
+#include "model/model_io.h"
 
 using namespace mrsnake;
 namespace fs = std::filesystem;

@@ -14,11 +14,11 @@
 
 #include "mesh/distance.h"
 #include "mesh/image_io.h"
-#include "snake/evaluate.h"
-#include "snake/model_bridge.h"
+#include "evaluation/evaluate.h"
+#include "model/snake_adapter.h"
 #include "snake/rasterize.h"
 #include "snake/segment.h"
-#include "wavelets/model_io.h"
+#include "model/model_io.h"
 
 using namespace mrsnake;
 

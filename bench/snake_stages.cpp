@@ -10,13 +10,13 @@
 #include <cstdlib>
 #include <string>
 
-#include "snake/evaluate.h"
-#include "snake/model_bridge.h"
+#include "evaluation/evaluate.h"
+#include "model/snake_adapter.h"
 #include "snake/rasterize.h"
 #include "snake/segment.h"
 #include "tests/support/shrink_wrap.h"
-#include "snake/synth.h"
-#include "wavelets/model.h"
+#include "phantoms/synth.h"
+#include "model/shape_model.h"
 
 using namespace mrsnake;
 

@@ -7,7 +7,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mesh/byte_codec.h"
 #include "mesh/errors.h"
 #include "snake/sampler.h"
 #include "snake/surface_geometry.h"
@@ -202,81 +201,6 @@ void to_json(nlohmann::json& j, const ProfileAlignmentReport& r) {
       {"levels_aligned", r.levels_aligned},
       {"mean_shift_mm", r.mean_shift_mm},
       {"mean_abs_shift_mm", r.mean_abs_shift_mm}};
-}
-
-namespace {
-constexpr char kMagic[8] = {'M', 'R', 'S', 'A', 'P', 'P', '0', '2'};
-// Version 01 differs only in having no centre byte per level.
-constexpr char kMagicVersion01[8] = {'M', 'R', 'S', 'A', 'P', 'P', '0', '1'};
-
-constexpr const char* kTruncated =
-    "the model's appearance section is truncated; rebuild the model with build-model --image";
-}  // namespace
-
-std::vector<std::uint8_t> serialize_appearance(const Appearance& a) {
-  ByteWriter b(std::vector<std::uint8_t>(kMagic, kMagic + 8));
-  b.put<std::int32_t>(a.half_length);
-  b.put<std::int32_t>(static_cast<std::int32_t>(a.levels.size()));
-  b.put<double>(a.region.inside);
-  b.put<double>(a.region.outside);
-  b.put<double>(a.inside_spread);
-  b.put<double>(a.outside_spread);
-  b.put<double>(a.shell_mm);
-  for (const LevelAppearance& l : a.levels) {
-    b.put<double>(l.spacing_mm);
-    b.put<std::uint8_t>(l.centre == ProfileCentre::edges ? 1 : 0);
-    b.put<std::int32_t>(static_cast<std::int32_t>(l.profiles.rows()));
-    b.put<std::int32_t>(static_cast<std::int32_t>(l.profiles.cols()));
-    for (int r = 0; r < l.profiles.rows(); ++r)
-      for (int c = 0; c < l.profiles.cols(); ++c) b.put<float>(l.profiles(r, c));
-  }
-  return b.take();
-}
-
-Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes) {
-  const bool version01 = bytes.size() >= 8 && std::memcmp(bytes.data(), kMagicVersion01, 8) == 0;
-  if (bytes.size() < 8 || (!version01 && std::memcmp(bytes.data(), kMagic, 8) != 0))
-    throw InputError("the model's appearance section is not in a format this build reads; rebuild the model");
-  ByteReader r(bytes, 8, kTruncated);
-  Appearance a;
-  a.half_length = r.get<std::int32_t>();
-  const int levels = r.get<std::int32_t>();
-  if (a.half_length < 0 || a.half_length > 1000 || levels < 0 || levels > 64)
-    throw InputError("the model's appearance section is inconsistent; rebuild the model");
-  a.region.inside = r.get<double>();
-  a.region.outside = r.get<double>();
-  a.inside_spread = r.get<double>();
-  a.outside_spread = r.get<double>();
-  a.shell_mm = r.get<double>();
-  // The segmentation divides by the spreads and compares with the medians: a non-finite one
-  // would silently derail it, so it is a defect of the model, not a value to use.
-  for (double x : {a.region.inside, a.region.outside, a.inside_spread, a.outside_spread, a.shell_mm})
-    if (!std::isfinite(x))
-      throw InputError("the model's appearance section holds non-finite statistics; rebuild the model");
-  for (int j = 0; j < levels; ++j) {
-    LevelAppearance l;
-    l.spacing_mm = r.get<double>();
-    if (version01) {
-      l.centre = ProfileCentre::unrecorded;
-    } else {
-      const auto centred = r.get<std::uint8_t>();
-      if (centred > 1) throw InputError("the model's appearance section is inconsistent; rebuild the model");
-      l.centre = centred == 1 ? ProfileCentre::edges : ProfileCentre::labels;
-    }
-    const int rows = r.get<std::int32_t>(), cols = r.get<std::int32_t>();
-    if (rows < 0 || cols != 2 * a.half_length + 1 || !(l.spacing_mm > 0) ||
-        static_cast<std::size_t>(rows) * cols * sizeof(float) > bytes.size() - r.position())
-      throw InputError("the model's appearance section is inconsistent; rebuild the model");
-    l.profiles.resize(rows, cols);
-    for (int i = 0; i < rows; ++i)
-      for (int c = 0; c < cols; ++c) l.profiles(i, c) = r.get<float>();
-    if (!l.profiles.allFinite() || !std::isfinite(l.spacing_mm))
-      throw InputError("the model's appearance section holds non-finite profiles; rebuild the model");
-    a.levels.push_back(std::move(l));
-  }
-  if (r.position() != bytes.size())
-    throw InputError("the model's appearance section has trailing bytes; rebuild the model");
-  return a;
 }
 
 double profile_step_residual(const Appearance& a, const std::vector<RowMatrixX3i>& faces) {

@@ -120,13 +120,6 @@ void to_json(nlohmann::json& j, const ProfileAlignmentReport& r);
 /// \return +infinity if there is no contrast, or faces do not match the levels.
 double profile_step_residual(const Appearance& appearance, const std::vector<RowMatrixX3i>& faces);
 
-/// Binary form (little-endian, versioned), for the model's optional "appearance" section.
-/// Version 02 adds each level's centre (labels or edges).
-std::vector<std::uint8_t> serialize_appearance(const Appearance& appearance);
-/// Reads versions 01 (every level's centre ProfileCentre::unrecorded) and 02.
-/// \throw InputError if the bytes are truncated, of another version or inconsistent.
-Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes);
-
 /// Summary for reports: levels, samples per profile, region statistics, and per level the
 /// profile spacing and where the profiles are centred ("edges", "labels", or "unrecorded").
 void to_json(nlohmann::json& j, const Appearance& a);

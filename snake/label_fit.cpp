@@ -2,7 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "snake/evaluate.h"
+#include "evaluation/evaluate.h"
 #include "snake/rasterize.h"
 
 namespace mrsnake {

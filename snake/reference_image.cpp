@@ -8,23 +8,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mesh/byte_codec.h"
 #include "mesh/errors.h"
-#include "wavelets/model_io.h"
 
 namespace mrsnake {
-
-namespace {
-constexpr char kMagic[8] = {'M', 'R', 'S', 'N', 'K', 'R', 'E', 'F'};
-constexpr std::uint32_t kVersion = 1;
-constexpr std::size_t kHeaderBytes = 8 + 4 + 3 * 4 + 15 * 8;  // magic, version, size, spacing, origin, direction
-constexpr std::uint32_t kMaxAxis = 1024;
-
-InputError defect(const std::string& what) {
-  return InputError("the model's reference image section " + what + "; rebuild the model with build-model --image");
-}
-
-}  // namespace
 
 Volume make_reference_crop(const Volume& image, const RowMatrixX3d& V, const ReferenceImageOptions& options) {
   if (V.rows() == 0) throw InputError("no surface to crop the reference image around");
@@ -78,57 +64,6 @@ Volume make_reference_crop(const Volume& image, const RowMatrixX3d& V, const Ref
         out.at(i, j, k) = static_cast<float>(sum * weight);
       }
   return out;
-}
-
-std::vector<std::uint8_t> serialize_reference_image(const Volume& r) {
-  ByteWriter b(std::vector<std::uint8_t>(kMagic, kMagic + 8));
-  b.put<std::uint32_t>(kVersion);
-  for (int a = 0; a < 3; ++a) b.put<std::uint32_t>(static_cast<std::uint32_t>(r.size[a]));
-  for (double s : r.spacing) b.put<double>(s);
-  for (double o : r.origin) b.put<double>(o);
-  for (double d : r.direction) b.put<double>(d);
-  for (float v : r.data) b.put<float>(v);
-  b.put<std::uint64_t>(fnv1a64(b.bytes().data(), b.bytes().size()));
-  return b.take();
-}
-
-Volume deserialize_reference_image(const std::vector<std::uint8_t>& bytes) {
-  if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0)
-    throw defect("is not in a format this build reads");
-  ByteReader r(bytes, 8, defect("is truncated").what());
-  if (r.get<std::uint32_t>() != kVersion) throw defect("has a version this build does not read");
-  Volume v;
-  for (int a = 0; a < 3; ++a) {
-    const std::uint32_t n = r.get<std::uint32_t>();
-    if (n < 8 || n > kMaxAxis) throw defect("has an impossible size");
-    v.size[a] = n;
-  }
-  for (double& s : v.spacing) s = r.get<double>();
-  for (double& o : v.origin) o = r.get<double>();
-  for (double& d : v.direction) d = r.get<double>();
-  const std::size_t expected = kHeaderBytes + 4 * v.num_voxels() + 8;
-  if (bytes.size() < expected) throw defect("is truncated");
-  if (bytes.size() > expected) throw defect("has trailing bytes");
-  // The header reader stands at the voxels (kHeaderBytes); the checksum follows them.
-  v.data.resize(v.num_voxels());
-  for (float& x : v.data) x = r.get<float>();
-  if (r.get<std::uint64_t>() != fnv1a64(bytes.data(), expected - 8))
-    throw defect("was altered or corrupted (its checksum does not match)");
-  for (int a = 0; a < 3; ++a)
-    // Bounds far beyond any scanner's (µm to m voxels, km away) keep index arithmetic finite.
-    if (!(v.spacing[a] >= 1e-3 && v.spacing[a] <= 1e3) || !(std::abs(v.origin[a]) <= 1e7))
-      throw defect("has an impossible frame");
-  // The direction must be a rotation or a reflection: orthonormal columns.
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) {
-      double dot = 0;
-      for (int c = 0; c < 3; ++c) dot += v.direction[3 * c + a] * v.direction[3 * c + b];
-      if (!(std::abs(dot - (a == b ? 1.0 : 0.0)) < 1e-6))
-        throw defect("has a direction matrix that is not orthonormal");
-    }
-  for (float x : v.data)
-    if (!std::isfinite(x)) throw defect("holds non-finite values");
-  return v;
 }
 
 void reference_image_to_json(nlohmann::json& j, const Volume& r) {

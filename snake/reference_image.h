@@ -31,14 +31,6 @@ struct ReferenceImageOptions {
 /// \throw InputError if the points miss the image or the crop has fewer than 8 voxels along an axis.
 Volume make_reference_crop(const Volume& image, const RowMatrixX3d& V, const ReferenceImageOptions& options = {});
 
-/// Binary form (little-endian, versioned, with its own FNV-1a 64 checksum).
-/// \pre reference.data has reference.num_voxels() values; each size is 8..1024 (as the
-///      reader requires: a larger crop would write a section its own reader refuses).
-std::vector<std::uint8_t> serialize_reference_image(const Volume& reference);
-/// \throw InputError if the bytes are truncated, of another format or version, altered
-///        (checksum), or describe an impossible image (sizes, spacing, direction, values).
-Volume deserialize_reference_image(const std::vector<std::uint8_t>& bytes);
-
 /// Summary for reports: size, spacing, origin, extent, voxel count.
 void reference_image_to_json(nlohmann::json& j, const Volume& reference);
 

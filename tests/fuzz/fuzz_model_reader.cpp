@@ -17,8 +17,8 @@
 
 #include "mesh/errors.h"
 #include "mesh/primitives.h"
-#include "wavelets/model.h"
-#include "wavelets/model_io.h"
+#include "model/shape_model.h"
+#include "model/model_io.h"
 
 namespace fs = std::filesystem;
 using namespace mrsnake;

@@ -13,7 +13,8 @@
 #include "mesh/errors.h"
 #include "snake/appearance.h"
 #include "snake/reference_image.h"
-#include "wavelets/model_io.h"
+#include "model/model_io.h"
+#include "model/sections.h"
 
 using namespace mrsnake;
 

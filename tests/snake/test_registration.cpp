@@ -18,15 +18,16 @@
 #include "mesh/primitives.h"
 #include "snake/image_pyramid.h"
 #include "snake/initialize.h"
-#include "snake/model_bridge.h"
+#include "model/snake_adapter.h"
 #include "snake/reference_image.h"
 #include "snake/registration_itk.h"
 #include "snake/segment.h"
 #include "tests/support/midpoint_frame_model.h"
-#include "snake/synth.h"
+#include "phantoms/synth.h"
 #include "tests/test_support.h"
 #include "tests/wavelets/hierarchies.h"
-#include "wavelets/model_io.h"
+#include "model/model_io.h"
+#include "model/sections.h"
 
 using namespace mrsnake;
 namespace fs = std::filesystem;

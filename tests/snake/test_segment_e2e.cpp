@@ -16,10 +16,10 @@
 #include "mesh/mesh_io.h"
 #include "mesh/marching_cubes.h"
 #include "mesh/image_io.h"
-#include "snake/evaluate.h"
-#include "snake/model_bridge.h"
+#include "evaluation/evaluate.h"
+#include "model/snake_adapter.h"
 #include "tests/test_support.h"
-#include "wavelets/model_io.h"
+#include "model/model_io.h"
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
@@ -28,7 +28,7 @@
 #include "snake/rasterize.h"
 #include "snake/segment.h"
 #include "tests/support/shrink_wrap.h"
-#include "snake/synth.h"
+#include "phantoms/synth.h"
 
 using namespace mrsnake;
 

@@ -10,6 +10,7 @@
 #include <random>
 #include <set>
 
+#include "model/sections.h"
 #include "mesh/distance.h"
 #include "mesh/errors.h"
 #include "mesh/marching_cubes.h"

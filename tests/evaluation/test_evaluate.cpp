@@ -11,8 +11,8 @@
 #include "mesh/image_io.h"
 #include "mesh/mesh_io.h"
 #include "mesh/primitives.h"
-#include "snake/evaluate.h"
-#include "snake/image_filters_itk.h"
+#include "evaluation/evaluate.h"
+#include "mesh/image_filters_itk.h"
 #include "tests/test_support.h"
 
 namespace mrsnake {

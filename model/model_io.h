@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mesh/progress.h"
-#include "wavelets/model.h"
+#include "model/shape_model.h"
 
 namespace mrsnake {
 

@@ -13,8 +13,8 @@
 #include "mesh/marching_cubes.h"
 #include "mesh/mesh_io.h"
 #include "mesh/topology.h"
-#include "snake/evaluate.h"
-#include "snake/synth.h"
+#include "evaluation/evaluate.h"
+#include "phantoms/synth.h"
 #include "tests/test_support.h"
 
 namespace mrsnake {

@@ -5,7 +5,7 @@
 #include <limits>
 #include <vector>
 
-#include "mesh/byte_codec.h"
+#include "model/byte_codec.h"
 #include "mesh/errors.h"
 
 namespace mrsnake {

@@ -1,4 +1,4 @@
-#include "snake/evaluate.h"
+#include "evaluation/evaluate.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mesh/errors.h"
-#include "snake/image_filters_itk.h"
+#include "mesh/image_filters_itk.h"
 
 namespace mrsnake {
 namespace {

@@ -1,7 +1,7 @@
 #pragma once
 /// \file model.h
 /// The multiresolution shape model: the coarse mesh S_0 plus the wavelet details that
-/// rebuild every finer level, as the segmentation loads it. On disk: wavelets/model_io.h.
+/// rebuild every finer level, as the segmentation loads it. On disk: model/model_io.h.
 #include <array>
 #include <cstdint>
 #include <map>

@@ -1,4 +1,4 @@
-#include "snake/synth.h"
+#include "phantoms/synth.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +12,7 @@
 #include "mesh/errors.h"
 #include "mesh/marching_cubes.h"
 #include "mesh/parallel.h"
-#include "snake/image_filters_itk.h"
+#include "mesh/image_filters_itk.h"
 
 namespace mrsnake {
 namespace {

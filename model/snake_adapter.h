@@ -1,13 +1,13 @@
 #pragma once
-/// \file model_bridge.h
-/// The shape model on disk (wavelets/model.h) as the segmentation sees it: its levels, a
+/// \file snake_adapter.h
+/// The shape model on disk (model/shape_model.h) as the segmentation sees it: its levels, a
 /// synthesis step from a deformed S_j with the stored details, and the optional appearance
 /// section ("appearance") that build-model --image adds.
 #include "mesh/volume.h"
 #include "snake/appearance.h"
 #include "snake/reference_image.h"
 #include "snake/segment.h"
-#include "wavelets/model.h"
+#include "model/shape_model.h"
 
 namespace mrsnake {
 

@@ -10,7 +10,7 @@
 
 #include "mesh/image_io.h"
 #include "tests/test_support.h"
-#include "wavelets/model_io.h"
+#include "model/model_io.h"
 
 using namespace mrsnake;
 using namespace mrsnake::test;

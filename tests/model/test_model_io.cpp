@@ -9,7 +9,7 @@
 #include "mesh/errors.h"
 #include "tests/test_support.h"
 #include "tests/wavelets/hierarchies.h"
-#include "wavelets/model_io.h"
+#include "model/model_io.h"
 
 using namespace mrsnake;
 using namespace mrsnake::test;

@@ -1,4 +1,4 @@
-#include "wavelets/model_io.h"
+#include "model/model_io.h"
 
 #include <unistd.h>
 
@@ -10,7 +10,7 @@
 #include <iterator>
 
 #include "mesh/atomic_file.h"
-#include "mesh/byte_codec.h"
+#include "model/byte_codec.h"
 #include "mesh/errors.h"
 #include "mesh/json_text.h"
 #include "mesh/mesh_io.h"

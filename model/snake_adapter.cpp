@@ -1,8 +1,9 @@
-#include "snake/model_bridge.h"
+#include "model/snake_adapter.h"
 
 #include <memory>
 
 #include "mesh/errors.h"
+#include "model/sections.h"
 #include "snake/image_pyramid.h"
 #include "wavelets/lifting.h"
 

@@ -1,5 +1,5 @@
 // ITK translation unit: no Eigen and no CGAL here (ITK bundles its own Eigen).
-#include "snake/image_filters_itk.h"
+#include "mesh/image_filters_itk.h"
 
 #include <itkImage.h>
 #include <itkImportImageFilter.h>

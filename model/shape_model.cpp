@@ -1,4 +1,4 @@
-#include "wavelets/model.h"
+#include "model/shape_model.h"
 
 #include "mesh/errors.h"
 
