@@ -233,8 +233,8 @@ void add_build_model_command(CLI::App& app) {
     ro.levels = a->levels;
     ro.target_faces = faces;
     ro.sphere_map = a->sphere_map;
-    ro.fit_rounds = a->fit_rounds;
-    ro.curvature_weight = a->curvature_weight;
+    ro.fit.rounds = a->fit_rounds;
+    ro.sizing.curvature_weight = a->curvature_weight;
     ro.keep_input_locator = true;  // for the report page, built while the map is solved
     ro.compute_stats = a->full_report;
     ro.progress = progress;

@@ -44,7 +44,7 @@ void add_remesh_command(CLI::App& app) {
   auto* strict =
       cmd->add_flag("--strict", args->strict, "Relax only the new vertices of each level (the paper's exact method)");
   no_relax->excludes(strict);
-  add_fit_rounds_option(*cmd, args->options.fit_rounds);
+  add_fit_rounds_option(*cmd, args->options.fit.rounds);
   add_sphere_map_option(*cmd, args->options.sphere_map);
   cmd->add_flag("--compare-unrelaxed", args->compare_unrelaxed,
                 "Also remesh without relaxation (a second run) and compare both in report.html and report.json")

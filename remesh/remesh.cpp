@@ -83,18 +83,19 @@ SizingFields sizing_fields(const TriMesh& surface, const RemeshOptions& options,
   const int n = surface.num_vertices();
   const Eigen::VectorXd kappa = vertex_curvature(surface, 8);
   SizingFields s{Eigen::VectorXd::Ones(n), Eigen::VectorXd::Ones(n)};
-  if (const double mean = kappa.mean(); options.curvature_weight > 0 && mean > 0)
+  if (const double mean = kappa.mean(); options.sizing.curvature_weight > 0 && mean > 0)
     // Capped, so that a few sharp spots (voxel steps of a marching-cubes surface) cannot pull
     // the spacing down so fast that triangle shapes suffer.
-    s.wanted.array() += options.curvature_weight * (kappa.array() / mean).pow(options.curvature_exponent).min(3.0);
+    s.wanted.array() +=
+        options.sizing.curvature_weight * (kappa.array() / mean).pow(options.sizing.curvature_exponent).min(3.0);
   // Averaged over about a base spacing (sqrt(n / n0) edge rings): the base follows where the
   // surface bends at its own scale, not voxel steps.
-  if (options.base_density_exponent > 0) {
+  if (options.base.density_exponent > 0) {
     const int passes =
-        options.base_density_smoothing < 0 ? base_spacing_rings(surface, n0) : options.base_density_smoothing;
-    s.base_density = smooth_vertex_field(surface, s.wanted, passes).array().pow(options.base_density_exponent).matrix();
+        options.base.density_smoothing < 0 ? base_spacing_rings(surface, n0) : options.base.density_smoothing;
+    s.base_density = smooth_vertex_field(surface, s.wanted, passes).array().pow(options.base.density_exponent).matrix();
   }
-  const double max_bend = options.max_base_bend;
+  const double max_bend = options.base.max_bend;
   if (!(max_bend > 0)) return s;
   const Eigen::VectorXd bend_kappa = smooth_vertex_field(surface, kappa, base_spacing_rings(surface, n0));
   const double bound_points = bend_bound_points(surface, bend_kappa, max_bend);
@@ -118,27 +119,27 @@ SizingFields sizing_fields(const TriMesh& surface, const RemeshOptions& options,
 RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   if (options.levels < 0 || options.levels > 12) throw std::invalid_argument("levels must be in [0, 12]");
   if (options.levels == 0 && options.target_faces < 16) throw std::invalid_argument("target_faces must be at least 16");
-  if (options.lloyd_iterations < 0) throw std::invalid_argument("lloyd_iterations must be >= 0");
-  if (options.shape_iterations < 0) throw std::invalid_argument("shape_iterations must be >= 0");
-  if (!(options.base_density_exponent >= 0 && options.base_density_exponent <= 4))
+  if (options.relaxation.lloyd_iterations < 0) throw std::invalid_argument("lloyd_iterations must be >= 0");
+  if (options.relaxation.shape_iterations < 0) throw std::invalid_argument("shape_iterations must be >= 0");
+  if (!(options.base.density_exponent >= 0 && options.base.density_exponent <= 4))
     throw std::invalid_argument("base_density_exponent must be in [0, 4]");
-  if (!(options.max_base_bend >= 0)) throw std::invalid_argument("max_base_bend must be >= 0");
-  if (options.base_density_smoothing < -1) throw std::invalid_argument("base_density_smoothing must be >= -1");
-  if (options.snap_tips < 0) throw std::invalid_argument("snap_tips must be >= 0");
-  if (options.fit_rounds < 0) throw std::invalid_argument("fit_rounds must be >= 0");
-  if (options.surface_relax_iterations < 0) throw std::invalid_argument("surface_relax_iterations must be >= 0");
-  if (!(options.surface_relax_quality_floor >= 0 && options.surface_relax_quality_floor <= 1))
+  if (!(options.base.max_bend >= 0)) throw std::invalid_argument("max_base_bend must be >= 0");
+  if (options.base.density_smoothing < -1) throw std::invalid_argument("base_density_smoothing must be >= -1");
+  if (options.snap.max_snaps < 0) throw std::invalid_argument("snap_tips must be >= 0");
+  if (options.fit.rounds < 0) throw std::invalid_argument("fit_rounds must be >= 0");
+  if (options.relaxation.surface_iterations < 0) throw std::invalid_argument("surface_relax_iterations must be >= 0");
+  if (!(options.relaxation.surface_quality_floor >= 0 && options.relaxation.surface_quality_floor <= 1))
     throw std::invalid_argument("surface_relax_quality_floor must be in [0, 1]");
-  if (!(options.curvature_exponent > 0 && options.curvature_exponent <= 4))
+  if (!(options.sizing.curvature_exponent > 0 && options.sizing.curvature_exponent <= 4))
     throw std::invalid_argument("curvature_exponent must be in (0, 4]");
-  if (options.repair_sweeps < 0) throw std::invalid_argument("repair_sweeps must be >= 0");
-  if (!(options.repair_threshold > 0 && options.repair_threshold <= 1))
+  if (options.repair.sweeps < 0) throw std::invalid_argument("repair_sweeps must be >= 0");
+  if (!(options.repair.threshold > 0 && options.repair.threshold <= 1))
     throw std::invalid_argument("repair_threshold must be in (0, 1]");
-  if (!(options.repair_error_tolerance >= 0)) throw std::invalid_argument("repair_error_tolerance must be >= 0");
-  if (options.rim_min_triangles < 1 || options.rim_min_triangles > 3)
+  if (!(options.repair.error_tolerance >= 0)) throw std::invalid_argument("repair_error_tolerance must be >= 0");
+  if (options.base.rim_min_triangles < 1 || options.base.rim_min_triangles > 3)
     throw std::invalid_argument("rim_min_triangles must be in [1, 3]");
   if (options.base_vertices < 6) throw std::invalid_argument("base_vertices must be at least 6");
-  if (!(options.density_exponent >= 0 && options.density_exponent <= 8))
+  if (!(options.sizing.density_exponent >= 0 && options.sizing.density_exponent <= 8))
     throw std::invalid_argument("density_exponent must be in [0, 8]");
   if (input.empty()) throw InputError("the mesh has no faces");
 
@@ -154,8 +155,8 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   TriMesh work = original;
   bool simplified = false;
   const double finest_faces = 2.0 * n0 * std::pow(4.0, levels);
-  const double limit = std::max<double>(options.simplify_above_faces, 8 * finest_faces);
-  if (options.simplify_above_faces > 0 && original.num_faces() > limit) {
+  const double limit = std::max<double>(options.simplify.above_faces, 8 * finest_faces);
+  if (options.simplify.above_faces > 0 && original.num_faces() > limit) {
     report(options.progress, "simplify", 0);
     TriMesh simplified_mesh = simplify_to_faces(original, static_cast<int>(limit));
     result.parameterization["simplify_seconds"] = seconds_since(simplify_start);
@@ -175,7 +176,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   std::shared_ptr<SurfaceLocator> input_locator;
   // Like the snap and the repair, the fit is part of the full method only: --no-relax and
   // --strict stay the paper's baseline and exact method, with every vertex on the input.
-  const int fit_rounds = options.relax == RelaxMode::all_vertices ? options.fit_rounds : 0;
+  const int fit_rounds = options.relax == RelaxMode::all_vertices ? options.fit.rounds : 0;
   const bool needs_locator = simplified || fit_rounds > 0 || options.compute_stats || options.keep_input_locator;
   run_both_in_parallel([&] { param = parameterize(work, param_options); },
                        [&] {
@@ -197,7 +198,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   const SizingFields sizing = sizing_fields(param.surface, options, levels, n0);
   const Eigen::VectorXd& wanted = sizing.wanted;
   const Eigen::VectorXd& base_density = sizing.base_density;
-  const BaseMesh base = build_base_mesh(param, n0, options.rim_min_triangles, &base_density);
+  const BaseMesh base = build_base_mesh(param, n0, options.base.rim_min_triangles, &base_density);
   n0 = static_cast<int>(base.domain.rows());
   result.connectivity = subdivide_connectivity(base.faces, n0, levels);
   result.parameterization["base_vertices"] = n0;
@@ -207,7 +208,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   result.parameterization["base_dropped_rim_samples"] = base.dropped_rim_samples;
 
   DensityField density{&domain_mesh,
-                       param.vertex_stretch.cwiseProduct(wanted).array().pow(options.density_exponent).matrix()};
+                       param.vertex_stretch.cwiseProduct(wanted).array().pow(options.sizing.density_exponent).matrix()};
   const DomainKind kind = param.kind;
 
   RowMatrixX3d U = base.domain;
@@ -215,7 +216,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   for (int i = 0; i < n0; ++i) hints[i] = domain_mesh.locate(U.row(i).transpose(), 0).face;
 
   LloydOptions lloyd;
-  lloyd.iterations = options.lloyd_iterations;
+  lloyd.iterations = options.relaxation.lloyd_iterations;
   double setup_seconds = seconds_since(base_start);
 
   for (int j = 0; j <= levels; ++j) {
@@ -235,16 +236,17 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     LloydStats relax_stats;
     RemeshLevel level;
     int shape_moves = 0;
-    if (options.relax == RelaxMode::all_vertices && options.shape_iterations > 0) {
+    if (options.relax == RelaxMode::all_vertices && options.relaxation.shape_iterations > 0) {
       // Lloyd (sizes) and shape smoothing (angles) pull against each other; interleaving
       // them in rounds balances the two better than running one after the other.
-      const int rounds = options.shape_iterations;
+      const int rounds = options.relaxation.shape_iterations;
       ShapeSmoothingOptions shape;
       shape.iterations = 1;
-      shape.move_rim = options.smooth_rim;
+      shape.move_rim = options.relaxation.smooth_rim;
       lloyd.first_movable = 0;
       for (int round = 0; round < rounds; ++round) {
-        lloyd.iterations = options.lloyd_iterations * (round + 1) / rounds - options.lloyd_iterations * round / rounds;
+        lloyd.iterations = options.relaxation.lloyd_iterations * (round + 1) / rounds -
+                           options.relaxation.lloyd_iterations * round / rounds;
         const LloydStats s = constrained_lloyd(kind, F, density, U, hints, lloyd);
         relax_stats.moves += s.moves;
         relax_stats.shortened_moves += s.shortened_moves;
@@ -257,7 +259,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       const bool relax =
           options.relax == RelaxMode::all_vertices || (options.relax == RelaxMode::new_vertices_only && j > 0);
       if (relax) {
-        lloyd.iterations = options.lloyd_iterations;
+        lloyd.iterations = options.relaxation.lloyd_iterations;
         lloyd.first_movable =
             options.relax == RelaxMode::new_vertices_only ? result.connectivity.vertex_count(j - 1) : 0;
         relax_stats = constrained_lloyd(kind, F, density, U, hints, lloyd);
@@ -266,36 +268,34 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     }
     // Sizes last: the area-centroid target evens out what the Lloyd step in D left uneven
     // where the stretch changes fast; its quality floor keeps the shapes just made.
-    if (options.relax == RelaxMode::all_vertices && options.surface_relax_iterations > 0) {
+    if (options.relax == RelaxMode::all_vertices && options.relaxation.surface_iterations > 0) {
       ShapeSmoothingOptions surface;
-      surface.iterations = options.surface_relax_iterations;
+      surface.iterations = options.relaxation.surface_iterations;
       surface.target = SmoothingTarget::area_centroid;
       surface.surface_density = &wanted;
-      surface.move_rim = options.smooth_rim;
-      surface.quality_floor = options.surface_relax_quality_floor;
+      surface.move_rim = options.relaxation.smooth_rim;
+      surface.quality_floor = options.relaxation.surface_quality_floor;
       shape_moves += smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, surface);
     }
     int snapped = 0;
     std::vector<bool> snapped_mask;
-    if (options.relax == RelaxMode::all_vertices && options.snap_tips > 0 && j == levels) {
-      FeatureSnapOptions snap;
-      snap.max_snaps = options.snap_tips;
-      snapped =
-          snap_to_input_tips(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, snap, &snapped_mask);
+    if (options.relax == RelaxMode::all_vertices && options.snap.max_snaps > 0 && j == levels) {
+      snapped = snap_to_input_tips(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, options.snap,
+                                   &snapped_mask);
     }
     // Onto the original input before the repair, so that the repair sees (and keeps) the
     // final triangles: the projection onto a marching-cubes staircase shears a few of them.
-    const bool project_first = reproject && options.repair_after_reprojection;
+    const bool project_first = reproject && options.repair.after_reprojection;
     if (project_first) reproject_onto(*reproject, level.positions);
     TriangleRepairStats repair;
-    if (options.relax == RelaxMode::all_vertices && options.repair_sweeps > 0 &&
-        (options.repair_coarse_levels || j == levels)) {
+    if (options.relax == RelaxMode::all_vertices && options.repair.sweeps > 0 &&
+        (options.repair.coarse_levels || j == levels)) {
       TriangleRepairOptions repair_options;
-      repair_options.sweeps = options.repair_sweeps;
-      repair_options.threshold = options.repair_threshold;
+      repair_options.sweeps = options.repair.sweeps;
+      repair_options.threshold = options.repair.threshold;
       // Not against a staircase: its voxel steps, not the triangles, make the guard's distances.
-      repair_options.guard_surface_error = options.repair_guard_finest && j == levels && !project_first;
-      repair_options.error_tolerance = options.repair_error_tolerance;
+      repair_options.guard_surface_error = options.repair.guard_finest && j == levels && !project_first;
+      repair_options.error_tolerance = options.repair.error_tolerance;
       if (project_first) repair_options.project_onto = reproject;
       if (snapped > 0) repair_options.fixed = &snapped_mask;  // the tips stay exactly on the input
       repair = repair_worst_triangles(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, repair_options);
@@ -310,7 +310,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     if (fit_rounds > 0 && j == levels) {
       // Against the original input. A disk's rim stays on the input's rim, and the snapped
       // tips stay exactly on the input's tips (they were kept for lowering the largest distance).
-      SurfaceFitOptions fit_options;
+      SurfaceFitOptions fit_options = options.fit;
       fit_options.rounds = fit_rounds;
       std::vector<bool> fixed =
           kind == DomainKind::disk ? boundary_vertices(F, static_cast<int>(U.rows())) : std::vector<bool>{};
@@ -369,26 +369,26 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["domain"] = result.domain;
   j["levels"] = result.connectivity.levels();
   j["relax"] = relax_name(options.relax);
-  j["density_exponent"] = options.density_exponent;
-  j["curvature_weight"] = options.curvature_weight;
-  j["curvature_exponent"] = options.curvature_exponent;
-  j["surface_relax_iterations"] = options.relax == RelaxMode::all_vertices ? options.surface_relax_iterations : 0;
-  j["surface_relax_quality_floor"] = options.surface_relax_quality_floor;
-  j["smooth_rim"] = options.smooth_rim;
-  j["base_density_exponent"] = options.base_density_exponent;
-  j["repair_after_reprojection"] = options.repair_after_reprojection;
-  j["snap_tips"] = options.relax == RelaxMode::all_vertices ? options.snap_tips : 0;
-  j["fit_rounds"] = options.relax == RelaxMode::all_vertices ? options.fit_rounds : 0;
-  j["base_density_smoothing"] = options.base_density_smoothing;
-  j["max_base_bend"] = options.max_base_bend;
-  j["lloyd_iterations"] = options.lloyd_iterations;
-  j["shape_iterations"] = options.relax == RelaxMode::all_vertices ? options.shape_iterations : 0;
-  j["repair_sweeps"] = options.relax == RelaxMode::all_vertices ? options.repair_sweeps : 0;
-  j["repair_threshold"] = options.repair_threshold;
-  j["repair_coarse_levels"] = options.repair_coarse_levels;
-  j["repair_guard_finest"] = options.repair_guard_finest;
-  j["repair_error_tolerance"] = options.repair_error_tolerance;
-  j["rim_min_triangles"] = options.rim_min_triangles;
+  j["density_exponent"] = options.sizing.density_exponent;
+  j["curvature_weight"] = options.sizing.curvature_weight;
+  j["curvature_exponent"] = options.sizing.curvature_exponent;
+  j["surface_relax_iterations"] = options.relax == RelaxMode::all_vertices ? options.relaxation.surface_iterations : 0;
+  j["surface_relax_quality_floor"] = options.relaxation.surface_quality_floor;
+  j["smooth_rim"] = options.relaxation.smooth_rim;
+  j["base_density_exponent"] = options.base.density_exponent;
+  j["repair_after_reprojection"] = options.repair.after_reprojection;
+  j["snap_tips"] = options.relax == RelaxMode::all_vertices ? options.snap.max_snaps : 0;
+  j["fit_rounds"] = options.relax == RelaxMode::all_vertices ? options.fit.rounds : 0;
+  j["base_density_smoothing"] = options.base.density_smoothing;
+  j["max_base_bend"] = options.base.max_bend;
+  j["lloyd_iterations"] = options.relaxation.lloyd_iterations;
+  j["shape_iterations"] = options.relax == RelaxMode::all_vertices ? options.relaxation.shape_iterations : 0;
+  j["repair_sweeps"] = options.relax == RelaxMode::all_vertices ? options.repair.sweeps : 0;
+  j["repair_threshold"] = options.repair.threshold;
+  j["repair_coarse_levels"] = options.repair.coarse_levels;
+  j["repair_guard_finest"] = options.repair.guard_finest;
+  j["repair_error_tolerance"] = options.repair.error_tolerance;
+  j["rim_min_triangles"] = options.base.rim_min_triangles;
   j["parameterization"] = result.parameterization;
   double total = result.parameterization.value("seconds", 0.0);
   nlohmann::json per_level = nlohmann::json::array();
