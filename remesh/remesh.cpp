@@ -20,6 +20,7 @@
 #include "remesh/simplify.h"
 #include "remesh/sizing.h"
 #include "remesh/surface_fit.h"
+#include "remesh/remesh_options_json.h"
 #include "remesh/triangle_repair.h"
 #include "mesh/topology.h"
 
@@ -368,6 +369,9 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   nlohmann::json j;
   j["domain"] = result.domain;
   j["levels"] = result.connectivity.levels();
+  // The options as `mrsnake remesh --config` reads them: the run can be repeated exactly.
+  j["options"] = options;
+  // The method's main settings at the top level too (the report page shows some of them).
   j["relax"] = relax_name(options.relax);
   j["density_exponent"] = options.sizing.density_exponent;
   j["curvature_weight"] = options.sizing.curvature_weight;

@@ -110,7 +110,8 @@ struct SimplifyOptions {
 };
 
 /// Options of remesh(). Either `levels` or `target_faces` chooses the resolution. Everything
-/// up to `fit` is the method; the rest is for the caller only.
+/// up to `fit` is the method (JSON: remesh/remesh_options_json.h, the form of
+/// `mrsnake remesh --config` and of report.json's "options"); the rest is for the caller only.
 struct RemeshOptions {
   /// Number of 1:4 splits L (> 0), or 0 to derive it from target_faces.
   int levels = 0;
