@@ -48,7 +48,7 @@ void add_segment_batch_command(CLI::App& app);
 /// Adds --sphere-map auto|halves|punctured (remesh and build-model), bound to `map`.
 void add_sphere_map_option(CLI::App& command, SphereMap& map);
 
-/// Adds --fit-rounds N (remesh and build-model), bound to `rounds` (RemeshOptions::fit_rounds);
+/// Adds --fit-rounds N (remesh and build-model), bound to `rounds` (RemeshOptions::fit.rounds);
 /// its current value is the default the help shows.
 void add_fit_rounds_option(CLI::App& command, int& rounds);
 

@@ -12,7 +12,9 @@
 #include "mesh/atomic_file.h"
 #include "mesh/errors.h"
 #include "mesh/image_io.h"
+#include "mesh/json_options.h"
 #include "model/build_model.h"
+#include "model/build_model_json.h"
 #include "model/model_io.h"
 
 namespace mrsnake::cli {
@@ -34,28 +36,36 @@ std::string poor_fit_cause(const StructureScale& scale, const SurfaceChoices& c)
     char text[200];
     std::snprintf(text, sizeof text,
                   "; the marching-cubes spacing %.3g mm is coarse for a structure of radius %.3g mm: "
-                  "give a smaller --mc-spacing (e.g. %.3g)",
+                  "give a smaller surface.mc_spacing_mm with --config (e.g. %.3g)",
                   c.mc_spacing, scale.equivalent_radius_mm, scale.finest_voxel_mm);
     return text;
   }
   std::string cause = "; the label may be too thin or ragged for a closed genus-0 model: check it with 'mrsnake mc'";
-  if (!c.spacing_given) cause += ", try --mc-spacing 0";
+  if (!c.spacing_given) cause += ", try surface.mc_spacing_mm 0 with --config";
   if (!c.faces_given) cause += ", or more --faces";
   return cause;
 }
 
-// The command's arguments: the library's options, and what the command itself does.
+// The command's arguments: the options file, and the flags that override it.
 struct BuildModelArgs {
-  std::string labels, image, output, predict = "butterfly", profile_alignment = "auto";
-  BuildModelOptions options;
-  bool full_report = false, json = false, compare_unrelaxed = false;
+  std::string labels, image, output, config;
+  int label = 1;
+  std::optional<int> faces, component, close_tunnels;
+  bool allow_poor_fit = false, json = false;
 };
 
+// The file's options (or the preset), then the flags given.
 BuildModelOptions options_of(const BuildModelArgs& a) {
-  BuildModelOptions o = a.options;
-  o.wavelet.predict = parse_predict_scheme(a.predict);
-  o.appearance.alignment = parse_profile_alignment(a.profile_alignment);
-  o.remesh.compute_stats = a.full_report;
+  BuildModelOptions o = a.config.empty() ? BuildModelOptions{} : read_options_file<BuildModelOptions>(a.config);
+  o.label = a.label;
+  if (a.faces) {
+    o.faces = *a.faces;
+    o.levels = 0;
+  }
+  if (a.component) o.component = *a.component;
+  if (a.close_tunnels) o.surface.close_tunnels = *a.close_tunnels;
+  if (a.allow_poor_fit) o.allow_poor_fit = true;
+  validate(o);
   return o;
 }
 
@@ -97,23 +107,15 @@ void warn_about(const BuiltModel& built, const BuildModelOptions& o) {
 
 // report.html: every level against the input, and the unrelaxed hierarchy when asked for.
 std::string report_page(const BuildModelArgs& a, const BuiltModel& built, const ProgressFn& progress) {
-  std::optional<RemeshResult> unrelaxed;
-  if (a.compare_unrelaxed) {
-    RemeshOptions plain = built.remesh;
-    plain.relax = RelaxMode::none;
-    plain.compute_stats = false;
-    plain.keep_input_locator = false;
-    unrelaxed = remesh(built.surface.mesh, plain);
-  }
   report(progress, "report.html", 0.0);
   mrsnake::reports::RemeshPageOptions page;
   page.title = "mrsnake build-model " + std::filesystem::path(a.output).filename().string();
   page.input = &built.surface.mesh;
   // remesh() built the input's distance tree on the other core while the map was solved.
   page.input_locator = built.hierarchy.input_locator.get();
-  page.unrelaxed = unrelaxed ? &*unrelaxed : nullptr;
+  page.unrelaxed = built.unrelaxed ? &*built.unrelaxed : nullptr;
   page.report = built.model.remesh_quality;
-  page.report["input"] = a.labels + " (label " + std::to_string(a.options.label) + ")";
+  page.report["input"] = a.labels + " (label " + std::to_string(a.label) + ")";
   page.timings = built.timings;
   const std::string html = mrsnake::reports::remesh_report_html(built.hierarchy, page);
   report(progress, "report.html", 1.0);
@@ -145,6 +147,7 @@ nlohmann::json summary_json(const BuildModelArgs& a, const BuiltModel& built, do
           {"detail_stats", stats},
           {"profile_alignment", built.alignment ? nlohmann::json(*built.alignment) : nlohmann::json()},
           {"timings", stages},
+          {"options", model.build_options},
           {"total_seconds", total_seconds}};
 }
 
@@ -223,71 +226,50 @@ void add_build_model_command(CLI::App& app) {
   auto a = std::make_shared<BuildModelArgs>();
   cmd->add_option("--labels", a->labels, "Label volume (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)")
       ->required();
-  cmd->add_option("--label", a->options.label, "Label value of the object")->required();
+  cmd->add_option("--label", a->label, "Label value of the object")->required();
+  cmd->add_option("--image", a->image,
+                  "Reference intensity image of the labels (same physical space): stores the appearance "
+                  "(profiles along the normals, inside/outside statistics) that 'mrsnake segment' matches, and a "
+                  "crop of the image around the organ that 'mrsnake segment --init register' registers to a new image");
   cmd->add_option("-o,--output", a->output, "Output model folder (replaced if it is already a model)")->required();
-  auto* levels = cmd->add_option("--levels", a->options.levels, "Number of levels L (1:4 splits of the base mesh)")
-                     ->check(CLI::Range(1, 10));
-  auto* faces =
-      cmd->add_option("--faces", a->options.faces,
-                      "Wanted face count of the finest level (default: triangles with edges of half the surface's "
-                      "sampling length, the marching-cubes spacing or the finest voxel, 1024 to 32768)")
-          ->check(CLI::Range(16, 50000000));
-  levels->excludes(faces);
-  add_sphere_map_option(*cmd, a->options.remesh.sphere_map);
-  add_fit_rounds_option(*cmd, a->options.remesh.fit_rounds);
-  cmd->add_option("--predict", a->predict, "Wavelet predict step: butterfly (default) or linear")
-      ->check(CLI::IsMember({"butterfly", "linear"}));
-  cmd->add_option("--smooth", a->options.surface.smoothing_iterations,
-                  "Windowed-sinc smoothing iterations of the marching-cubes surface (default 5, or 20 with "
-                  "--mc-spacing 0 to remove the voxel staircase; 0 = none)")
-      ->check(CLI::Range(0, 1000));
-  cmd->add_option("--mc-spacing", a->options.surface.mc_spacing_mm,
-                  "Marching cubes on the label's Gaussian-smoothed occupancy resampled to this isotropic spacing in mm "
-                  "(default: the structure's equivalent radius / 60 if the voxels are finer than that, else 0): a "
-                  "smooth surface of a size the model needs; 0 = the voxels' own surface (as 'mrsnake mc', much slower "
-                  "on a large fine label)")
-      ->check(CLI::Range(0.0, 100.0));
-  cmd->add_option("--close-tunnels", a->options.surface.close_tunnels,
+  cmd->add_option("--faces", a->faces,
+                  "Wanted face count of the finest level (default: triangles with edges of half the surface's "
+                  "sampling length, the marching-cubes spacing or the finest voxel, 1024 to 32768)")
+      ->check(CLI::Range(16, 50000000));
+  cmd->add_option("--close-tunnels", a->close_tunnels,
                   "If the label's surface is not genus 0, close the label with radii up to this many voxels until it "
                   "is (as 'mrsnake mc --close-tunnels'; default 3: a label's stray tunnels of a voxel or two are "
                   "closed with a warning, and the fit check refuses a closing that changed the shape); 0 = no repair")
       ->check(CLI::Range(0, 20));
   cmd->add_option(
-         "--component", a->options.component,
+         "--component", a->component,
          "Model only the label's K-th largest connected part (1 = the largest), e.g. one of a left and a right "
          "organ that share a label; its other parts count as background, in the appearance too; 0 = the "
          "whole label (its largest surface is modelled)")
       ->check(CLI::Range(0, 1000));
-  auto* image_option = cmd->add_option(
-      "--image", a->image,
-      "Reference intensity image of the labels (same physical space): stores the appearance "
-      "(profiles along the normals, inside/outside statistics) that 'mrsnake segment' matches, and a "
-      "crop of the image around the organ that 'mrsnake segment --init register' registers to a new image");
-  cmd->add_option("--profile-alignment", a->profile_alignment,
-                  "Where the profiles of --image are centred: 'edges' (the image's edge within half a voxel step of "
-                  "the label's surface: the label's rounding does not pass into the segmentations), 'labels' (the "
-                  "label's surface: the labels define the boundary, as an expert's on a real image), or 'auto' "
-                  "(edges when the profiles are clean steps, as in synthetic images)")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"auto", "edges", "labels"}))
-      ->needs(image_option);
-  cmd->add_option("--reference-margin", a->options.reference_margin_mm,
-                  "Margin (mm) of the stored reference image crop around the organ (with --image; default 6 "
-                  "equivalent radii of the structure)")
-      ->check(CLI::Range(0.0, 1000.0));
-  cmd->add_flag("--allow-poor-fit", a->options.allow_poor_fit,
+  cmd->add_flag("--allow-poor-fit", a->allow_poor_fit,
                 "Write the model even when its finest level, rasterized on the label's grid, has a Dice below 0.90 "
                 "against the label (otherwise refused with exit code 5)");
-  cmd->add_flag("--full-report", a->full_report, "Quality and distance to the input at every level (slower)");
-  cmd->add_flag("--compare-unrelaxed", a->compare_unrelaxed,
-                "Also remesh without relaxation and compare both in MODEL/report.html (a second remeshing run)");
+  cmd->add_option("--config", a->config,
+                  "Options from a JSON file (the form of model.json's \"build_options\"; keys left out keep the "
+                  "preset's values; docs/commands/build-model.md lists them); the flags given override it")
+      ->check(CLI::ExistingFile);
+  cmd->add_flag_callback(
+         "--print-config",
+         [] {
+           print_json(nlohmann::json(BuildModelOptions{}));
+           throw CLI::Success();
+         },
+         "Print the preset's options as JSON (a start for --config) and exit")
+      ->trigger_on_parse();
   cmd->add_flag("--json", a->json, "Print a JSON summary");
   cmd->footer(
       "Example: mrsnake build-model --labels liver-labels.nii.gz --label 255 --image liver.nii.gz -o liver.model "
       "--faces 32768\n"
       "Every default length follows the structure's size and voxels (model.json 'scale' records them). A label\n"
       "with tunnels of up to 3 voxels (genus > 0) is closed by default, e.g. the liver of abdomen-ct-small-seg.nii.gz\n"
-      "(label 5); wider ones need a larger --close-tunnels.");
+      "(label 5); wider ones need a larger --close-tunnels.\n"
+      "Build again exactly: mrsnake build-model ... --config <(jq .build_options MODEL/model.json)");
   cmd->callback([a] { run_build_model(*a); });
 }
 

@@ -8,9 +8,11 @@
 #include "apps/cli.h"
 #include "apps/report/remesh_page.h"
 #include "mesh/atomic_file.h"
+#include "mesh/json_options.h"
 #include "mesh/json_text.h"
 #include "mesh/mesh_io.h"
 #include "remesh/remesh.h"
+#include "remesh/remesh_options_json.h"
 
 namespace mrsnake::cli {
 
@@ -19,9 +21,9 @@ void add_remesh_command(CLI::App& app) {
                                  "Remesh a disk or closed genus-0 surface into a nested semi-regular hierarchy "
                                  "(level_0.vtp ... level_L.vtp, report.json and report.html)");
   struct Args {
-    std::string mesh, out;
+    std::string mesh, out, config;
     // Bound directly, so that the defaults live in one place. The method's other settings are
-    // one set of defaults for every shape (remesh/remesh.h), not options of the command.
+    // one set of defaults for every shape (remesh/remesh.h), read from --config to change them.
     RemeshOptions options;
     bool no_relax = false, strict = false, json = false, compare_unrelaxed = false;
   };
@@ -44,14 +46,31 @@ void add_remesh_command(CLI::App& app) {
   auto* strict =
       cmd->add_flag("--strict", args->strict, "Relax only the new vertices of each level (the paper's exact method)");
   no_relax->excludes(strict);
-  add_fit_rounds_option(*cmd, args->options.fit_rounds);
+  add_fit_rounds_option(*cmd, args->options.fit.rounds);
   add_sphere_map_option(*cmd, args->options.sphere_map);
+  cmd->add_option("--config", args->config,
+                  "Options of the method from a JSON file (the form of report.json's \"options\"; keys left out keep "
+                  "their defaults); the flags given override it")
+      ->check(CLI::ExistingFile);
+  cmd->add_flag_callback(
+         "--print-config",
+         [] {
+           print_json(nlohmann::json(RemeshOptions{}));
+           throw CLI::Success();
+         },
+         "Print the default options as JSON (a start for --config) and exit")
+      ->trigger_on_parse();
   cmd->add_flag("--compare-unrelaxed", args->compare_unrelaxed,
                 "Also remesh without relaxation (a second run) and compare both in report.html and report.json")
       ->excludes(no_relax);
   cmd->add_flag("--json", args->json, "Print report.json to stdout");
-  cmd->footer("Example: mrsnake remesh liver.vtp -o liver_model --faces 16000");
-  cmd->callback([args] {
+  cmd->footer(
+      "Example: mrsnake remesh liver.vtp -o liver_model --faces 16000\n"
+      "Repeat a run: mrsnake remesh liver.vtp -o again --config <(jq .options liver_model/report.json)");
+  auto* fit_rounds = cmd->get_option("--fit-rounds");
+  auto* sphere_map = cmd->get_option("--sphere-map");
+  auto* base_vertices = cmd->get_option("--base-vertices");
+  cmd->callback([args, levels, faces, base_vertices, fit_rounds, sphere_map] {
     // Only an earlier remesh output is replaced: checked before the work, and at the end.
     const ReplaceableFolder earlier = folder_of_entries(
         [](const std::string& name) {
@@ -60,11 +79,19 @@ void add_remesh_command(CLI::App& app) {
         },
         "an output of mrsnake remesh");
     require_replaceable(args->out, earlier);
+    // The file's options (or the defaults), then the flags given.
+    RemeshOptions options = args->config.empty() ? RemeshOptions{} : read_options_file<RemeshOptions>(args->config);
+    if (levels->count() > 0) options.levels = args->options.levels;
+    if (faces->count() > 0) {
+      options.target_faces = args->options.target_faces;
+      options.levels = 0;
+    }
+    if (base_vertices->count() > 0) options.base_vertices = args->options.base_vertices;
+    if (fit_rounds->count() > 0) options.fit.rounds = args->options.fit.rounds;
+    if (sphere_map->count() > 0) options.sphere_map = args->options.sphere_map;
+    if (args->no_relax) options.relax = RelaxMode::none;
+    if (args->strict) options.relax = RelaxMode::new_vertices_only;
     const TriMesh input = read_mesh(args->mesh);
-    RemeshOptions options = args->options;
-    options.relax = args->no_relax ? RelaxMode::none
-                    : args->strict ? RelaxMode::new_vertices_only
-                                   : RelaxMode::all_vertices;
     if (!global_options().quiet) options.progress = terminal_progress();
     const RemeshResult result = remesh(input, options);
     nlohmann::json report = remesh_report(result, options);

@@ -6,7 +6,7 @@
 # full-resolution marching-cubes surfaces (`mrsnake mc`, the voxels' own surface, and
 # `mrsnake mc --smooth 20`; 442,712 faces each) in % of their bounding-box diagonal, with its
 # triangle quality.
-# Usage: bench/bench_build_model.sh [extra build-model options, e.g. --faces 131072 --mc-spacing 0]
+# Usage: bench/bench_build_model.sh [extra build-model options, e.g. --faces 131072 --config FILE]
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="${MRSNAKE_BIN:-$root/build/apps/mrsnake}"

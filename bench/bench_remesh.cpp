@@ -426,7 +426,7 @@ const LabelInput kLabelInputs[] = {
     {"mouse-cerebellum", "volumes/mouse-brain/mouse1_labels.nii.gz", 8, 1},
 };
 
-/// build-model's default --close-tunnels (apps/cmd_build_model.cpp); a genus-0 label is untouched.
+/// build-model's default --close-tunnels (model/build_model.h); a genus-0 label is untouched.
 constexpr int kCloseTunnels = 3;
 
 const LabelInput* find_label_input(const std::string& name) {

@@ -776,8 +776,10 @@ void synthetic_cases(Bench& b, bool quick) {
                      "--seed", std::to_string(1000 + size.voxels), "-o", (mdir / "case").string()},
                     mdir, "synth");
       const fs::path model = mdir / "model";
+      const fs::path levels_config = mdir / "levels.json";
+      std::ofstream(levels_config) << "{\"levels\": " << size.levels << "}\n";
       const int levels = b.build_model(mdir / "case" / "truth.nii.gz", 1, mdir / "case" / "image.nii.gz", model,
-                                       {"--levels", std::to_string(size.levels)});
+                                       {"--config", levels_config.string()});
       for (std::size_t vi = 0; vi < size.variants.size(); ++vi) {
         const double snr = size.variants[vi].snr;
         const bool posed = size.variants[vi].posed;

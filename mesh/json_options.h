@@ -4,9 +4,12 @@
 /// report.json, so that a run can be repeated exactly. A struct opts in with nlohmann's
 /// NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT (missing keys keep their defaults);
 /// options_from_json adds the check that no key is misspelt.
+#include <cstddef>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -30,6 +33,34 @@ inline void check_known_keys(const nlohmann::json& given, const nlohmann::json& 
   }
 }
 }  // namespace detail
+
+/// An enum class as its name, from a table of (value, name) pairs.
+template <class Enum, std::size_t N>
+void enum_to_json(nlohmann::json& j, Enum value, const std::pair<Enum, const char*> (&names)[N]) {
+  for (const auto& [e, name] : names)
+    if (e == value) {
+      j = name;
+      return;
+    }
+  throw std::invalid_argument("an enum value without a name");
+}
+
+/// The enum named by a JSON string. Unlike NLOHMANN_JSON_SERIALIZE_ENUM, which maps an unknown
+/// string to the first value, a misspelt value is refused, naming the ones allowed.
+/// \throw InputError if j is not one of the names.
+template <class Enum, std::size_t N>
+void enum_from_json(const nlohmann::json& j, Enum& value, const std::pair<Enum, const char*> (&names)[N],
+                    const char* what) {
+  std::string allowed;
+  if (j.is_string())
+    for (const auto& [e, name] : names)
+      if (j.get<std::string>() == name) {
+        value = e;
+        return;
+      }
+  for (const auto& [e, name] : names) allowed += std::string(allowed.empty() ? "" : ", ") + '"' + name + '"';
+  throw InputError(std::string("bad ") + what + " " + j.dump() + ": must be one of " + allowed);
+}
 
 /// Options of type T from JSON: the keys given replace T's defaults, the rest keep them.
 /// \throw InputError on a key T does not have, or a value of the wrong type.

@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include <nlohmann/json.hpp>
 
 #include "mesh/label_repair.h"
 #include "mesh/quality.h"
+#include "model/build_model_json.h"
 #include "model/snake_adapter.h"
 #include "snake/rasterize.h"
 #include "snake/reference_image.h"
@@ -16,10 +18,9 @@ namespace mrsnake {
 
 RemeshOptions model_remesh_preset() {
   RemeshOptions o;
-  o.fit_rounds = 0;            // the vertices stay on the reference surface
-  o.curvature_weight = 1.0;    // denser where the organ bends
-  o.keep_input_locator = true;  // the report page measures every level against the input
-  o.compute_stats = false;      // the finest level is measured against the label instead
+  o.fit.rounds = 0;                 // the vertices stay on the reference surface
+  o.sizing.curvature_weight = 1.0;  // denser where the organ bends
+  o.keep_input_locator = true;      // the report page measures every level against the input
   return o;
 }
 
@@ -46,8 +47,8 @@ void extract_surface(const Volume& labels, const BuildModelOptions& options, con
   const ModelSurfaceOptions& o = options.surface;
   built.mc_spacing_mm = o.mc_spacing_mm >= 0 ? o.mc_spacing_mm : default_marching_cubes_spacing(built.scale);
   // The resampled occupancy has no staircase left to smooth away: a few iterations do.
-  built.smoothing_iterations = o.smoothing_iterations >= 0 ? o.smoothing_iterations
-                                                           : (built.mc_spacing_mm > 0 ? 5 : 20);
+  built.smoothing_iterations =
+      o.smoothing_iterations >= 0 ? o.smoothing_iterations : (built.mc_spacing_mm > 0 ? 5 : 20);
   LabelSurfaceOptions mc;
   mc.smoothing_iterations = built.smoothing_iterations;
   mc.max_closing_radius = o.close_tunnels;
@@ -55,13 +56,13 @@ void extract_surface(const Volume& labels, const BuildModelOptions& options, con
   built.surface = extract_label_surface(labels, options.label, mc, progress);
   const LabelSurface& s = built.surface;
   if (s.genus_before_repair > 0 && s.closing_radius == 0)
-    throw LabelGenusError("label " + std::to_string(options.label) + " has a genus-" +
-                              std::to_string(s.genus_before_repair) +
-                              " surface (tunnels through it), but a model needs genus 0" +
-                              (o.close_tunnels > 0 ? "; a closing of radius up to " + std::to_string(o.close_tunnels) +
-                                                         " voxels did not remove them"
-                                                   : std::string()),
-                          s.genus_before_repair);
+    throw LabelGenusError(
+        "label " + std::to_string(options.label) + " has a genus-" + std::to_string(s.genus_before_repair) +
+            " surface (tunnels through it), but a model needs genus 0" +
+            (o.close_tunnels > 0
+                 ? "; a closing of radius up to " + std::to_string(o.close_tunnels) + " voxels did not remove them"
+                 : std::string()),
+        s.genus_before_repair);
 }
 
 // The semi-regular hierarchy of the surface; its time split into the parameterization and the levels.
@@ -72,6 +73,7 @@ void remesh_surface(const BuildModelOptions& options, const ProgressFn& progress
   ro = options.remesh;
   ro.levels = options.levels;
   ro.target_faces = options.faces > 0 ? options.faces : default_face_count(built.surface.mesh, sampling_mm);
+  ro.compute_stats = options.report.level_stats;
   ro.progress = progress;
   built.hierarchy = remesh(built.surface.mesh, ro);
   clock.lap("remesh");
@@ -105,8 +107,8 @@ LabelFit fit_to_source(const TriMesh& finest, const Volume& labels, int label, b
 // A model that has lost its organ is refused here, before anything is written.
 void check_fit(const Volume& labels, const BuildModelOptions& options, BuiltModel& built) {
   const bool parts_dropped = !built.surface.dropped_component_faces.empty() && options.component == 0;
-  built.fit = fit_to_source(built.hierarchy.mesh(built.hierarchy.connectivity.levels()), labels, options.label,
-                            parts_dropped);
+  built.fit =
+      fit_to_source(built.hierarchy.mesh(built.hierarchy.connectivity.levels()), labels, options.label, parts_dropped);
   if (built.fit.dice >= kMinLabelFitDice || options.allow_poor_fit) return;
   throw PoorFitError(describe_poor_fit(built.fit), built);
 }
@@ -128,6 +130,7 @@ void add_image_sections(const Volume& image, const BuildModelOptions& options, c
 void record_provenance(const Volume& labels, const BuildModelOptions& options, BuiltModel& built) {
   ShapeModel& model = built.model;
   model.source_label = options.label;
+  model.build_options = options;
   if (options.component > 0) model.source_component = options.component;
   PhysicalFrame frame;
   frame.size = labels.size;
@@ -153,7 +156,33 @@ void record_provenance(const Volume& labels, const BuildModelOptions& options, B
   model.scale = scale;
 }
 
+// The same surface split without relaxation: the paper's baseline, for the report page.
+RemeshResult remesh_unrelaxed(const BuiltModel& built) {
+  RemeshOptions plain = built.remesh;
+  plain.relax = RelaxMode::none;
+  plain.compute_stats = false;
+  plain.keep_input_locator = false;
+  return remesh(built.surface.mesh, plain);
+}
+
+void require(bool ok, const char* key, const char* range) {
+  if (!ok) throw InputError(std::string("the option ") + key + " must be " + range);
+}
+
 }  // namespace
+
+void validate(const BuildModelOptions& o) {
+  require(o.component >= 0 && o.component <= 1000, "component", "0 (the whole label) to 1000");
+  require(std::isfinite(o.surface.mc_spacing_mm) && o.surface.mc_spacing_mm <= 100, "surface.mc_spacing_mm",
+          "at most 100 (mm; 0 = the voxels' surface, negative = derived)");
+  require(o.surface.smoothing_iterations <= 1000, "surface.smoothing_iterations", "at most 1000 (negative = derived)");
+  require(o.surface.close_tunnels >= 0 && o.surface.close_tunnels <= 20, "surface.close_tunnels", "0 to 20 voxels");
+  require(o.faces == 0 || (o.faces >= 16 && o.faces <= 50000000), "faces", "0 (derived) or 16 to 50000000");
+  require(o.levels >= 0 && o.levels <= 10, "levels", "0 (from faces) to 10");
+  require(o.faces == 0 || o.levels == 0, "faces", "0 when levels is given");
+  require(std::isfinite(o.reference_margin_mm) && o.reference_margin_mm <= 1000, "reference_margin_mm",
+          "at most 1000 (mm; negative = derived)");
+}
 
 std::string describe_poor_fit(const LabelFit& fit) {
   char text[256];
@@ -165,6 +194,7 @@ std::string describe_poor_fit(const LabelFit& fit) {
 
 BuiltModel build_model(const Volume& labels_in, const Volume* image, const BuildModelOptions& options,
                        const ProgressFn& progress) {
+  validate(options);
   StageClock clock;
   BuiltModel built;
   const Volume labels =
@@ -188,6 +218,7 @@ BuiltModel build_model(const Volume& labels_in, const Volume* image, const Build
     clock.lap("appearance");
   }
   record_provenance(labels, options, built);
+  if (options.report.compare_unrelaxed) built.unrelaxed = remesh_unrelaxed(built);
   built.timings = clock.laps();
   built.model.timings = built.timings;
   return built;

@@ -42,6 +42,12 @@ struct ModelSurfaceOptions {
   int close_tunnels = 3;
 };
 
+/// What build_model() measures beyond the model, for its report page.
+struct ModelReportOptions {
+  bool level_stats = false;        ///< quality and distance to the input at every level (slower)
+  bool compare_unrelaxed = false;  ///< also remesh without relaxation, for the comparison (a second run)
+};
+
 /// Options of build_model(); the defaults are the preset of `mrsnake build-model`.
 struct BuildModelOptions {
   int label = 1;      ///< label value of the structure
@@ -58,21 +64,26 @@ struct BuildModelOptions {
   double reference_margin_mm = -1;
   /// Keep a model whose finest level covers its label with a Dice below kMinLabelFitDice.
   bool allow_poor_fit = false;
+  ModelReportOptions report;
 };
+
+/// \throw InputError naming the JSON key of the first option out of its range.
+void validate(const BuildModelOptions& options);
 
 /// A model and what its stages measured on the way.
 struct BuiltModel {
-  ShapeModel model;         ///< with its provenance, quality, scale and timings filled
-  RemeshResult hierarchy;   ///< the semi-regular hierarchy the model analyses
-  RemeshOptions remesh;     ///< the options it was remeshed with, resolution included
-  LabelSurface surface;     ///< the marching-cubes surface it remeshes
-  StructureScale scale;     ///< the structure's size
-  LabelFit fit;             ///< the finest level against the label
+  ShapeModel model;                       ///< with its provenance, quality, scale and timings filled
+  RemeshResult hierarchy;                 ///< the semi-regular hierarchy the model analyses
+  RemeshOptions remesh;                   ///< the options it was remeshed with, resolution included
+  std::optional<RemeshResult> unrelaxed;  ///< with report.compare_unrelaxed
+  LabelSurface surface;                   ///< the marching-cubes surface it remeshes
+  StructureScale scale;                   ///< the structure's size
+  LabelFit fit;                           ///< the finest level against the label
   double mc_spacing_mm = 0;
   int smoothing_iterations = 0;
-  std::optional<double> reference_margin_mm;           ///< with an image
-  std::optional<ProfileAlignmentReport> alignment;     ///< with an image
-  std::vector<std::pair<std::string, double>> timings; ///< seconds per stage, in order
+  std::optional<double> reference_margin_mm;            ///< with an image
+  std::optional<ProfileAlignmentReport> alignment;      ///< with an image
+  std::vector<std::pair<std::string, double>> timings;  ///< seconds per stage, in order
 };
 
 /// The label's surface is not genus 0, and the allowed closing did not make it so.
@@ -103,7 +114,8 @@ std::string describe_poor_fit(const LabelFit& fit);
 
 /// A model of one label of `labels`, with the appearance of `image` when it is given.
 /// \pre image, when given, lies in the physical space of labels.
-/// \throw InputError if the label is absent or the image constant; LabelGenusError; the
+/// \throw InputError if the options are out of range (validate), the label is absent or the image constant;
+/// LabelGenusError; the
 ///        errors of remesh(); PoorFitError unless options.allow_poor_fit.
 BuiltModel build_model(const Volume& labels, const Volume* image, const BuildModelOptions& options = {},
                        const ProgressFn& progress = {});

@@ -284,6 +284,7 @@ void save_model(const std::string& folder, const ShapeModel& model, const Progre
   m["detail_stats"] = stats;
   m["remesh_quality"] = model.remesh_quality;
   if (!model.scale.is_null()) m["scale"] = model.scale;
+  if (!model.build_options.is_null()) m["build_options"] = model.build_options;
   nlohmann::json timings = nlohmann::json::array();
   for (const auto& [stage, seconds] : model.timings) timings.push_back({{"stage", stage}, {"seconds", seconds}});
   m["timings"] = timings;
@@ -394,6 +395,7 @@ ShapeModel load_model(const std::string& folder, const LoadModelOptions& options
     }
     model.remesh_quality = m.at("remesh_quality");
     if (m.contains("scale")) model.scale = m["scale"];
+    if (m.contains("build_options")) model.build_options = m["build_options"];
     for (const nlohmann::json& t : m.at("timings"))
       model.timings.emplace_back(t.at("stage").get<std::string>(), t.at("seconds").get<double>());
     for (const nlohmann::json& s : m.at("detail_stats")) {

@@ -46,6 +46,8 @@ struct ShapeModel {
   /// its label (build-model); null if none.
   nlohmann::json scale;
   std::vector<std::pair<std::string, double>> timings;  ///< seconds per stage, in order
+  /// The options it was built with, as `build-model --config` reads them; null if unknown.
+  nlohmann::json build_options;
   /// Optional named binary sections (e.g. "appearance"), stored as <name>.bin and listed,
   /// with their size and checksum, in the manifest. Names: [a-z0-9_]+, not "details".
   std::map<std::string, std::vector<std::uint8_t>> sections;

@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <chrono>
-#include <memory>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "mesh/distance.h"
 #include "mesh/errors.h"
@@ -20,6 +23,7 @@
 #include "remesh/simplify.h"
 #include "remesh/sizing.h"
 #include "remesh/surface_fit.h"
+#include "remesh/remesh_options_json.h"
 #include "remesh/triangle_repair.h"
 #include "mesh/topology.h"
 
@@ -32,15 +36,6 @@ using Clock = std::chrono::steady_clock;
 constexpr long long kMaxStatsSamples = 50000;
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-const char* relax_name(RelaxMode mode) {
-  switch (mode) {
-    case RelaxMode::all_vertices: return "all_vertices";
-    case RelaxMode::new_vertices_only: return "new_vertices_only";
-    case RelaxMode::none: return "none";
-  }
-  return "?";
-}
 
 // Levels L and base size n0 so that F0·4^L is near the target, with F0 in [128, 512): a base
 // of ~65-260 vertices spread over the shape absorbs its curvature, and since about half of
@@ -68,6 +63,12 @@ int base_spacing_rings(const TriMesh& surface, int n0) {
   return static_cast<int>(std::lround(std::sqrt(surface.num_vertices() / static_cast<double>(n0))));
 }
 
+// The hierarchy's shape: L levels of 1:4 splits over a base of n0 vertices.
+struct Resolution {
+  int levels;
+  int base_vertices;
+};
+
 // The wanted 3D point densities: `wanted` for the levels' relaxation, `base_density` for the
 // base vertices' spread (both relative, >= 1 where nothing asks for more).
 struct SizingFields {
@@ -79,28 +80,30 @@ struct SizingFields {
 // vertices (thin tubes, many tips), the base grows 4x and the hierarchy loses a level, unless
 // the levels were given or there is only one. The grown base is spread by the bound, and the
 // relaxation's density raised by the same factor, so that the levels keep the base's grading.
-SizingFields sizing_fields(const TriMesh& surface, const RemeshOptions& options, int& levels, int& n0) {
+SizingFields sizing_fields(const TriMesh& surface, const SizingOptions& sizing, const BaseMeshOptions& base,
+                           bool levels_given, Resolution& resolution) {
+  int& levels = resolution.levels;
+  int& n0 = resolution.base_vertices;
   const int n = surface.num_vertices();
   const Eigen::VectorXd kappa = vertex_curvature(surface, 8);
   SizingFields s{Eigen::VectorXd::Ones(n), Eigen::VectorXd::Ones(n)};
-  if (const double mean = kappa.mean(); options.curvature_weight > 0 && mean > 0)
+  if (const double mean = kappa.mean(); sizing.curvature_weight > 0 && mean > 0)
     // Capped, so that a few sharp spots (voxel steps of a marching-cubes surface) cannot pull
     // the spacing down so fast that triangle shapes suffer.
-    s.wanted.array() += options.curvature_weight * (kappa.array() / mean).pow(options.curvature_exponent).min(3.0);
+    s.wanted.array() += sizing.curvature_weight * (kappa.array() / mean).pow(sizing.curvature_exponent).min(3.0);
   // Averaged over about a base spacing (sqrt(n / n0) edge rings): the base follows where the
   // surface bends at its own scale, not voxel steps.
-  if (options.base_density_exponent > 0) {
-    const int passes =
-        options.base_density_smoothing < 0 ? base_spacing_rings(surface, n0) : options.base_density_smoothing;
-    s.base_density = smooth_vertex_field(surface, s.wanted, passes).array().pow(options.base_density_exponent).matrix();
+  if (base.density_exponent > 0) {
+    const int passes = base.density_smoothing < 0 ? base_spacing_rings(surface, n0) : base.density_smoothing;
+    s.base_density = smooth_vertex_field(surface, s.wanted, passes).array().pow(base.density_exponent).matrix();
   }
-  const double max_bend = options.max_base_bend;
+  const double max_bend = base.max_bend;
   if (!(max_bend > 0)) return s;
   const Eigen::VectorXd bend_kappa = smooth_vertex_field(surface, kappa, base_spacing_rings(surface, n0));
   const double bound_points = bend_bound_points(surface, bend_kappa, max_bend);
   // Below that, the curvature sizing alone spreads the base: the bound moved base vertices
   // onto small bent features such as a bear's ears (Q mean -0.013 at 16k faces).
-  if (options.levels != 0 || levels == 1 || bound_points <= 0.5 * n0) return s;
+  if (levels_given || levels == 1 || bound_points <= 0.5 * n0) return s;
   // Once: a base 16x larger leaves a hierarchy of two levels with 10 % irregular vertices (the
   // octopus at 16k faces), and a marching-cubes staircase's voxel steps, which the curvature
   // measure sees as bends, ask for it too (the liver).
@@ -113,252 +116,393 @@ SizingFields sizing_fields(const TriMesh& surface, const RemeshOptions& options,
   return s;
 }
 
-}  // namespace
+// \throw std::invalid_argument naming the first option out of range (by its JSON key path).
+void check_options(const RemeshOptions& o) {
+  if (o.levels < 0 || o.levels > 12) throw std::invalid_argument("levels must be in [0, 12]");
+  if (o.levels == 0 && o.target_faces < 16) throw std::invalid_argument("target_faces must be at least 16");
+  if (o.relaxation.lloyd_iterations < 0) throw std::invalid_argument("relaxation.lloyd_iterations must be >= 0");
+  if (o.relaxation.shape_iterations < 0) throw std::invalid_argument("relaxation.shape_iterations must be >= 0");
+  if (!(o.base.density_exponent >= 0 && o.base.density_exponent <= 4))
+    throw std::invalid_argument("base.density_exponent must be in [0, 4]");
+  if (!(o.base.max_bend >= 0)) throw std::invalid_argument("base.max_bend must be >= 0");
+  if (o.base.density_smoothing < -1) throw std::invalid_argument("base.density_smoothing must be >= -1");
+  if (o.snap.max_snaps < 0) throw std::invalid_argument("snap.max_snaps must be >= 0");
+  if (o.fit.rounds < 0) throw std::invalid_argument("fit.rounds must be >= 0");
+  if (o.relaxation.surface_iterations < 0) throw std::invalid_argument("relaxation.surface_iterations must be >= 0");
+  if (!(o.relaxation.surface_quality_floor >= 0 && o.relaxation.surface_quality_floor <= 1))
+    throw std::invalid_argument("relaxation.surface_quality_floor must be in [0, 1]");
+  if (!(o.sizing.curvature_exponent > 0 && o.sizing.curvature_exponent <= 4))
+    throw std::invalid_argument("sizing.curvature_exponent must be in (0, 4]");
+  if (o.repair.sweeps < 0) throw std::invalid_argument("repair.sweeps must be >= 0");
+  if (!(o.repair.threshold > 0 && o.repair.threshold <= 1))
+    throw std::invalid_argument("repair.threshold must be in (0, 1]");
+  if (!(o.repair.error_tolerance >= 0)) throw std::invalid_argument("repair.error_tolerance must be >= 0");
+  if (o.base.rim_min_triangles < 1 || o.base.rim_min_triangles > 3)
+    throw std::invalid_argument("base.rim_min_triangles must be in [1, 3]");
+  if (o.base_vertices < 6) throw std::invalid_argument("base_vertices must be at least 6");
+  if (!(o.sizing.density_exponent >= 0 && o.sizing.density_exponent <= 8))
+    throw std::invalid_argument("sizing.density_exponent must be in [0, 8]");
+}
 
-RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
-  if (options.levels < 0 || options.levels > 12) throw std::invalid_argument("levels must be in [0, 12]");
-  if (options.levels == 0 && options.target_faces < 16) throw std::invalid_argument("target_faces must be at least 16");
-  if (options.lloyd_iterations < 0) throw std::invalid_argument("lloyd_iterations must be >= 0");
-  if (options.shape_iterations < 0) throw std::invalid_argument("shape_iterations must be >= 0");
-  if (!(options.base_density_exponent >= 0 && options.base_density_exponent <= 4))
-    throw std::invalid_argument("base_density_exponent must be in [0, 4]");
-  if (!(options.max_base_bend >= 0)) throw std::invalid_argument("max_base_bend must be >= 0");
-  if (options.base_density_smoothing < -1) throw std::invalid_argument("base_density_smoothing must be >= -1");
-  if (options.snap_tips < 0) throw std::invalid_argument("snap_tips must be >= 0");
-  if (options.fit_rounds < 0) throw std::invalid_argument("fit_rounds must be >= 0");
-  if (options.surface_relax_iterations < 0) throw std::invalid_argument("surface_relax_iterations must be >= 0");
-  if (!(options.surface_relax_quality_floor >= 0 && options.surface_relax_quality_floor <= 1))
-    throw std::invalid_argument("surface_relax_quality_floor must be in [0, 1]");
-  if (!(options.curvature_exponent > 0 && options.curvature_exponent <= 4))
-    throw std::invalid_argument("curvature_exponent must be in (0, 4]");
-  if (options.repair_sweeps < 0) throw std::invalid_argument("repair_sweeps must be >= 0");
-  if (!(options.repair_threshold > 0 && options.repair_threshold <= 1))
-    throw std::invalid_argument("repair_threshold must be in (0, 1]");
-  if (!(options.repair_error_tolerance >= 0)) throw std::invalid_argument("repair_error_tolerance must be >= 0");
-  if (options.rim_min_triangles < 1 || options.rim_min_triangles > 3)
-    throw std::invalid_argument("rim_min_triangles must be in [1, 3]");
-  if (options.base_vertices < 6) throw std::invalid_argument("base_vertices must be at least 6");
-  if (!(options.density_exponent >= 0 && options.density_exponent <= 8))
-    throw std::invalid_argument("density_exponent must be in [0, 8]");
-  if (input.empty()) throw InputError("the mesh has no faces");
+// The levels L and the base size n0 asked for (the bend bound may still grow the base).
+Resolution initial_resolution(const RemeshOptions& options) {
+  Resolution r{options.levels, options.base_vertices};
+  if (r.levels == 0) choose_resolution(options.target_faces, r.levels, r.base_vertices);
+  return r;
+}
 
-  RemeshResult result;
-  const auto simplify_start = Clock::now();
-  const TriMesh original = remove_unreferenced_vertices(input);
-  const TopologyReport topology = topology_report(original);
-  require_disk_or_sphere(topology, "the input surface");
-  int levels = options.levels, n0 = options.base_vertices;
-  if (levels == 0) choose_resolution(options.target_faces, levels, n0);
-
-  // A much finer input is simplified before the (costly) parameterization.
-  TriMesh work = original;
+// The input as it is parameterized: the original without unreferenced vertices, or a
+// simplification of it when it is much finer than the finest level (the parameterization is
+// the costly part).
+struct PreparedInput {
+  TriMesh original;
+  TriMesh work;
   bool simplified = false;
-  const double finest_faces = 2.0 * n0 * std::pow(4.0, levels);
-  const double limit = std::max<double>(options.simplify_above_faces, 8 * finest_faces);
-  if (options.simplify_above_faces > 0 && original.num_faces() > limit) {
-    report(options.progress, "simplify", 0);
-    TriMesh simplified_mesh = simplify_to_faces(original, static_cast<int>(limit));
-    result.parameterization["simplify_seconds"] = seconds_since(simplify_start);
+  nlohmann::json simplify_info;  ///< simplify_seconds, when a simplification was made
+};
+
+// \throw TopologyError if the input is neither a disk nor a closed genus-0 surface.
+PreparedInput prepare_input(const TriMesh& input, const SimplifyOptions& options, const Resolution& resolution,
+                            const ProgressFn& progress, Clock::time_point start) {
+  PreparedInput p;
+  p.original = remove_unreferenced_vertices(input);
+  const TopologyReport topology = topology_report(p.original);
+  require_disk_or_sphere(topology, "the input surface");
+  p.work = p.original;
+  const double finest_faces = 2.0 * resolution.base_vertices * std::pow(4.0, resolution.levels);
+  const double limit = std::max<double>(options.above_faces, 8 * finest_faces);
+  if (options.above_faces > 0 && p.original.num_faces() > limit) {
+    report(progress, "simplify", 0);
+    TriMesh simplified_mesh = simplify_to_faces(p.original, static_cast<int>(limit));
+    p.simplify_info["simplify_seconds"] = seconds_since(start);
     const TopologyReport after = topology_report(simplified_mesh);
     if (after.is_disk() == topology.is_disk() && after.is_closed_genus0() == topology.is_closed_genus0()) {
-      work = std::move(simplified_mesh);
-      simplified = true;
+      p.work = std::move(simplified_mesh);
+      p.simplified = true;
     }
   }
+  return p;
+}
 
-  report(options.progress, "parameterize", 0);
-  ParameterizationOptions param_options;
-  param_options.sphere_map = options.sphere_map;
+// The parameterization of the prepared input, and the original's closest-point tree (for the
+// reprojection, the fit and the report's distances) built on the other core meanwhile.
+struct MappedInput {
   Parameterization param;
-  // The input's closest-point tree (for the reprojection, the fit and the report's distances)
-  // is built on the other core while the map is solved.
-  std::shared_ptr<SurfaceLocator> input_locator;
-  // Like the snap and the repair, the fit is part of the full method only: --no-relax and
-  // --strict stay the paper's baseline and exact method, with every vertex on the input.
-  const int fit_rounds = options.relax == RelaxMode::all_vertices ? options.fit_rounds : 0;
-  const bool needs_locator = simplified || fit_rounds > 0 || options.compute_stats || options.keep_input_locator;
-  run_both_in_parallel([&] { param = parameterize(work, param_options); },
-                       [&] {
-                         if (needs_locator) input_locator = std::make_shared<SurfaceLocator>(original);
-                       });
-  result.input_locator = input_locator;
-  const SurfaceLocator* reproject = simplified ? input_locator.get() : nullptr;
-  result.domain = param.kind == DomainKind::sphere ? "sphere" : "disk";
-  const nlohmann::json simplify_info = result.parameterization;
-  result.parameterization = param.summary;
-  if (simplify_info.is_object()) result.parameterization.update(simplify_info);
-  result.parameterization["input_faces"] = original.num_faces();
-  result.parameterization["parameterized_faces"] = work.num_faces();
-  result.parameterization["seconds"] = seconds_since(simplify_start);  // input checks and simplification included
+  std::shared_ptr<SurfaceLocator> locator;  ///< null unless asked for
+};
 
-  const auto base_start = Clock::now();
-  const DomainMesh domain_mesh(param.domain, param.surface.F);
-  report(options.progress, "base mesh", 0);
-  const SizingFields sizing = sizing_fields(param.surface, options, levels, n0);
-  const Eigen::VectorXd& wanted = sizing.wanted;
-  const Eigen::VectorXd& base_density = sizing.base_density;
-  const BaseMesh base = build_base_mesh(param, n0, options.rim_min_triangles, &base_density);
-  n0 = static_cast<int>(base.domain.rows());
-  result.connectivity = subdivide_connectivity(base.faces, n0, levels);
+MappedInput map_onto_domain(const PreparedInput& input, SphereMap sphere_map, bool needs_locator,
+                            const ProgressFn& progress) {
+  report(progress, "parameterize", 0);
+  ParameterizationOptions param_options;
+  param_options.sphere_map = sphere_map;
+  MappedInput m;
+  run_both_in_parallel([&] { m.param = parameterize(input.work, param_options); },
+                       [&] {
+                         if (needs_locator) m.locator = std::make_shared<SurfaceLocator>(input.original);
+                       });
+  return m;
+}
+
+nlohmann::json parameterization_summary(const MappedInput& mapped, const PreparedInput& input,
+                                        Clock::time_point start) {
+  nlohmann::json summary = mapped.param.summary;
+  if (input.simplify_info.is_object()) summary.update(input.simplify_info);
+  summary["input_faces"] = input.original.num_faces();
+  summary["parameterized_faces"] = input.work.num_faces();
+  summary["seconds"] = seconds_since(start);  // input checks and simplification included
+  return summary;
+}
+
+// The base mesh T0 in D, spread by the sizing's base density; sets n0 to its vertex count, and
+// the result's connectivity and the base's keys of its parameterization summary.
+BaseMesh build_base(const Parameterization& param, const BaseMeshOptions& options, const SizingFields& sizing,
+                    Resolution& resolution, RemeshResult& result) {
+  BaseMesh base = build_base_mesh(param, resolution.base_vertices, options.rim_min_triangles, &sizing.base_density);
+  const int n0 = static_cast<int>(base.domain.rows());
+  resolution.base_vertices = n0;
+  result.connectivity = subdivide_connectivity(base.faces, n0, resolution.levels);
   result.parameterization["base_vertices"] = n0;
   result.parameterization["base_faces"] = base.faces.rows();
   result.parameterization["base_surface_flips"] = base.surface_flips;
   result.parameterization["base_valence_flips"] = base.valence_flips;
   result.parameterization["base_dropped_rim_samples"] = base.dropped_rim_samples;
+  return base;
+}
 
-  DensityField density{&domain_mesh,
-                       param.vertex_stretch.cwiseProduct(wanted).array().pow(options.density_exponent).matrix()};
-  const DomainKind kind = param.kind;
+// The Lloyd density in D: (stretch·wanted)^density_exponent per vertex of the domain mesh.
+DensityField lloyd_density(const DomainMesh& domain_mesh, const Parameterization& param, const SizingFields& sizing,
+                           const SizingOptions& options) {
+  return DensityField{&domain_mesh,
+                      param.vertex_stretch.cwiseProduct(sizing.wanted).array().pow(options.density_exponent).matrix()};
+}
 
-  RowMatrixX3d U = base.domain;
-  std::vector<int> hints(n0, 0);
-  for (int i = 0; i < n0; ++i) hints[i] = domain_mesh.locate(U.row(i).transpose(), 0).face;
+// The level being built, in D: positions, and a face of the domain mesh under each vertex.
+struct DomainLayout {
+  RowMatrixX3d U;
+  std::vector<int> hints;
+};
 
+DomainLayout base_layout(const BaseMesh& base, const DomainMesh& domain_mesh) {
+  DomainLayout layout{base.domain, std::vector<int>(base.domain.rows(), 0)};
+  for (int i = 0; i < static_cast<int>(base.domain.rows()); ++i)
+    layout.hints[i] = domain_mesh.locate(layout.U.row(i).transpose(), 0).face;
+  return layout;
+}
+
+// What every level is built on.
+struct LevelContext {
+  DomainKind kind;
+  const DomainMesh& domain_mesh;    ///< the parameterized surface in D
+  const RowMatrixX3d& surface_V;    ///< and in 3D
+  const DensityField& density;      ///< the Lloyd density
+  const Eigen::VectorXd& wanted;    ///< the wanted 3D density per vertex of the parameterized surface
+  const TriMesh& original;          ///< the input without unreferenced vertices
+  const SurfaceLocator* locator;    ///< its closest points, if built
+  const SurfaceLocator* reproject;  ///< the same, when a simplification was parameterized; else null
+  const SubdivisionConnectivity& connectivity;
+  int fit_rounds;  ///< 0 unless the full method fits the finest level
+};
+
+// Level j > 0: the 1:4 split of level j-1 in D, new vertices projected onto D.
+void split_level(const SubdivisionConnectivity& c, int j, DomainKind kind, DomainLayout& layout) {
+  RowMatrixX3d& U = layout.U;
+  U = midpoint_refine(c, j - 1, U);
+  const std::vector<bool> boundary = kind == DomainKind::disk
+                                         ? boundary_vertices(c.faces[j], static_cast<int>(U.rows()))
+                                         : std::vector<bool>(U.rows(), false);
+  const int previous = c.vertex_count(j - 1);
+  layout.hints.resize(U.rows());
+  for (int v = previous; v < U.rows(); ++v) {
+    U.row(v) = project_to_domain(kind, U.row(v).transpose(), boundary[v]).transpose();
+    layout.hints[v] = layout.hints[c.parents(v)[0]];
+  }
+}
+
+struct RelaxStats {
+  LloydStats lloyd;
+  int shape_moves = 0;
+};
+
+// Lloyd steps in D, with the full method interleaved with shape smoothing in rounds (sizes and
+// angles pull against each other; rounds balance the two better than one after the other),
+// then the lift X.
+RelaxStats relax_in_domain(const LevelContext& ctx, RelaxMode mode, const RelaxationOptions& options, int j,
+                           DomainLayout& layout, RowMatrixX3d& X) {
+  const RowMatrixX3i& F = ctx.connectivity.faces[j];
+  RelaxStats stats;
   LloydOptions lloyd;
-  lloyd.iterations = options.lloyd_iterations;
-  double setup_seconds = seconds_since(base_start);
+  if (mode == RelaxMode::all_vertices && options.shape_iterations > 0) {
+    const int rounds = options.shape_iterations;
+    ShapeSmoothingOptions shape;
+    shape.iterations = 1;
+    shape.move_rim = options.smooth_rim;
+    lloyd.first_movable = 0;
+    for (int round = 0; round < rounds; ++round) {
+      lloyd.iterations = options.lloyd_iterations * (round + 1) / rounds - options.lloyd_iterations * round / rounds;
+      const LloydStats s = constrained_lloyd(ctx.kind, F, ctx.density, layout.U, layout.hints, lloyd);
+      stats.lloyd.moves += s.moves;
+      stats.lloyd.shortened_moves += s.shortened_moves;
+      stats.lloyd.rejected_moves += s.rejected_moves;
+      stats.lloyd.mean_shift = s.mean_shift;
+      X = lift_to_surface(ctx.domain_mesh, ctx.surface_V, layout.U, layout.hints);
+      stats.shape_moves +=
+          smooth_shapes_in_domain(ctx.kind, F, ctx.domain_mesh, ctx.surface_V, layout.U, X, layout.hints, shape);
+    }
+    return stats;
+  }
+  if (mode == RelaxMode::all_vertices || (mode == RelaxMode::new_vertices_only && j > 0)) {
+    lloyd.iterations = options.lloyd_iterations;
+    lloyd.first_movable = mode == RelaxMode::new_vertices_only ? ctx.connectivity.vertex_count(j - 1) : 0;
+    stats.lloyd = constrained_lloyd(ctx.kind, F, ctx.density, layout.U, layout.hints, lloyd);
+  }
+  X = lift_to_surface(ctx.domain_mesh, ctx.surface_V, layout.U, layout.hints);
+  return stats;
+}
 
-  for (int j = 0; j <= levels; ++j) {
-    const auto start = Clock::now();
-    const RowMatrixX3i& F = result.connectivity.faces[j];
-    if (j > 0) {
-      U = midpoint_refine(result.connectivity, j - 1, U);
-      const std::vector<bool> boundary = kind == DomainKind::disk ? boundary_vertices(F, static_cast<int>(U.rows()))
-                                                                  : std::vector<bool>(U.rows(), false);
-      const int previous = result.connectivity.vertex_count(j - 1);
-      hints.resize(U.rows());
-      for (int v = previous; v < U.rows(); ++v) {
-        U.row(v) = project_to_domain(kind, U.row(v).transpose(), boundary[v]).transpose();
-        hints[v] = hints[result.connectivity.parents(v)[0]];
-      }
-    }
-    LloydStats relax_stats;
-    RemeshLevel level;
-    int shape_moves = 0;
-    if (options.relax == RelaxMode::all_vertices && options.shape_iterations > 0) {
-      // Lloyd (sizes) and shape smoothing (angles) pull against each other; interleaving
-      // them in rounds balances the two better than running one after the other.
-      const int rounds = options.shape_iterations;
-      ShapeSmoothingOptions shape;
-      shape.iterations = 1;
-      shape.move_rim = options.smooth_rim;
-      lloyd.first_movable = 0;
-      for (int round = 0; round < rounds; ++round) {
-        lloyd.iterations = options.lloyd_iterations * (round + 1) / rounds - options.lloyd_iterations * round / rounds;
-        const LloydStats s = constrained_lloyd(kind, F, density, U, hints, lloyd);
-        relax_stats.moves += s.moves;
-        relax_stats.shortened_moves += s.shortened_moves;
-        relax_stats.rejected_moves += s.rejected_moves;
-        relax_stats.mean_shift = s.mean_shift;
-        level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
-        shape_moves += smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, shape);
-      }
-    } else {
-      const bool relax =
-          options.relax == RelaxMode::all_vertices || (options.relax == RelaxMode::new_vertices_only && j > 0);
-      if (relax) {
-        lloyd.iterations = options.lloyd_iterations;
-        lloyd.first_movable =
-            options.relax == RelaxMode::new_vertices_only ? result.connectivity.vertex_count(j - 1) : 0;
-        relax_stats = constrained_lloyd(kind, F, density, U, hints, lloyd);
-      }
-      level.positions = lift_to_surface(domain_mesh, param.surface.V, U, hints);
-    }
-    // Sizes last: the area-centroid target evens out what the Lloyd step in D left uneven
-    // where the stretch changes fast; its quality floor keeps the shapes just made.
-    if (options.relax == RelaxMode::all_vertices && options.surface_relax_iterations > 0) {
-      ShapeSmoothingOptions surface;
-      surface.iterations = options.surface_relax_iterations;
-      surface.target = SmoothingTarget::area_centroid;
-      surface.surface_density = &wanted;
-      surface.move_rim = options.smooth_rim;
-      surface.quality_floor = options.surface_relax_quality_floor;
-      shape_moves += smooth_shapes_in_domain(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, surface);
-    }
-    int snapped = 0;
-    std::vector<bool> snapped_mask;
-    if (options.relax == RelaxMode::all_vertices && options.snap_tips > 0 && j == levels) {
-      FeatureSnapOptions snap;
-      snap.max_snaps = options.snap_tips;
-      snapped =
-          snap_to_input_tips(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, snap, &snapped_mask);
-    }
-    // Onto the original input before the repair, so that the repair sees (and keeps) the
-    // final triangles: the projection onto a marching-cubes staircase shears a few of them.
-    const bool project_first = reproject && options.repair_after_reprojection;
-    if (project_first) reproject_onto(*reproject, level.positions);
-    TriangleRepairStats repair;
-    if (options.relax == RelaxMode::all_vertices && options.repair_sweeps > 0 &&
-        (options.repair_coarse_levels || j == levels)) {
-      TriangleRepairOptions repair_options;
-      repair_options.sweeps = options.repair_sweeps;
-      repair_options.threshold = options.repair_threshold;
-      // Not against a staircase: its voxel steps, not the triangles, make the guard's distances.
-      repair_options.guard_surface_error = options.repair_guard_finest && j == levels && !project_first;
-      repair_options.error_tolerance = options.repair_error_tolerance;
-      if (project_first) repair_options.project_onto = reproject;
-      if (snapped > 0) repair_options.fixed = &snapped_mask;  // the tips stay exactly on the input
-      repair = repair_worst_triangles(kind, F, domain_mesh, param.surface.V, U, level.positions, hints, repair_options);
-    }
-    report(options.progress, "level " + std::to_string(j), 0.5);
-    if (reproject && !project_first) reproject_onto(*reproject, level.positions);
-    const int flipped = count_flipped(U, F);
-    if (flipped > 0)
-      throw AlgorithmError("level " + std::to_string(j) + " has " + std::to_string(flipped) +
-                           " flipped triangles in the domain; the surface cannot be remeshed well");
-    SurfaceFitStats fit;
-    if (fit_rounds > 0 && j == levels) {
-      // Against the original input. A disk's rim stays on the input's rim, and the snapped
-      // tips stay exactly on the input's tips (they were kept for lowering the largest distance).
-      SurfaceFitOptions fit_options;
-      fit_options.rounds = fit_rounds;
-      std::vector<bool> fixed =
-          kind == DomainKind::disk ? boundary_vertices(F, static_cast<int>(U.rows())) : std::vector<bool>{};
-      if (snapped > 0) {
-        if (fixed.empty()) fixed.assign(snapped_mask.size(), false);
-        for (std::size_t v = 0; v < snapped_mask.size(); ++v) fixed[v] = fixed[v] || snapped_mask[v];
-      }
-      fit = fit_to_surface(F, level.positions, *input_locator, fit_options, fixed);
-    }
-    level.domain_positions = U;
-    level.flipped_triangles = flipped;
-    level.seconds = seconds_since(start) + (j == 0 ? setup_seconds : 0.0);
-    nlohmann::json& s = level.stats;
-    s["level"] = j;
-    s["vertices"] = level.positions.rows();
-    s["faces"] = F.rows();
-    s["flipped_triangles"] = flipped;
-    s["seconds"] = level.seconds;
-    s["lloyd_shortened_moves"] = relax_stats.shortened_moves;
-    s["lloyd_rejected_moves"] = relax_stats.rejected_moves;
-    s["lloyd_last_mean_shift"] = relax_stats.mean_shift;
-    s["shape_moves"] = shape_moves;
-    s["repair_moves"] = repair.moves;
-    s["snapped_vertices"] = snapped;
-    if (fit_rounds > 0 && j == levels)
-      s["fit"] = {{"rms_before_mm", fit.rms_before},          {"rms_after_mm", fit.rms_after},
-                  {"mean_offset_mm", fit.mean_offset},        {"max_offset_mm", fit.max_offset},
-                  {"clamped_vertices", fit.clamped_vertices}, {"held_vertices", fit.held_vertices}};
-    if (repair.moves > 0) {
-      s["repair_q_min_before"] = repair.q_min_before;
-      s["repair_q_min_after"] = repair.q_min_after;
-    }
-    if (options.compute_stats) {
-      const TriMesh mesh{level.positions, F};
-      s["quality"] = mesh_quality(mesh);
-      // Metro-style sampling of both surfaces, then a uniform random subset of at most 50k
-      // points per surface: a marching-cubes input has hundreds of thousands of faces, and
-      // 50k points estimate the RMS to well under 1 % (the Hausdorff distance is the largest
-      // over the subset).
-      DistanceOptions sampling;
-      sampling.samples_per_face =
-          std::clamp(static_cast<int>(5e5 / std::max(original.num_faces(), mesh.num_faces())), 1, 10);
-      sampling.max_samples_per_mesh = kMaxStatsSamples;
-      s["distance"] = surface_distance(mesh, original, *input_locator, sampling);
-      s["distance"]["samples_per_face"] = sampling.samples_per_face;
-      s["distance"]["max_samples_per_mesh"] = sampling.max_samples_per_mesh;
-    }
-    result.levels.push_back(std::move(level));
+// Sizes last: the area-centroid target evens out what the Lloyd step in D left uneven where the
+// stretch changes fast; its quality floor keeps the shapes just made. Returns the moves.
+int relax_on_surface(const LevelContext& ctx, const RelaxationOptions& options, int j, DomainLayout& layout,
+                     RowMatrixX3d& X) {
+  ShapeSmoothingOptions surface;
+  surface.iterations = options.surface_iterations;
+  surface.target = SmoothingTarget::area_centroid;
+  surface.surface_density = &ctx.wanted;
+  surface.move_rim = options.smooth_rim;
+  surface.quality_floor = options.surface_quality_floor;
+  return smooth_shapes_in_domain(ctx.kind, ctx.connectivity.faces[j], ctx.domain_mesh, ctx.surface_V, layout.U, X,
+                                 layout.hints, surface);
+}
+
+// The finest level's vertices snapped onto the input's tips; `snapped` marks them.
+int snap_tips(const LevelContext& ctx, const FeatureSnapOptions& options, int j, DomainLayout& layout, RowMatrixX3d& X,
+              std::vector<bool>& snapped) {
+  return snap_to_input_tips(ctx.kind, ctx.connectivity.faces[j], ctx.domain_mesh, ctx.surface_V, layout.U, X,
+                            layout.hints, options, &snapped);
+}
+
+// The repair of the worst triangles; on the original input when the level was projected onto it
+// first. Snapped tips (`snapped`, if any) stay exactly on the input.
+TriangleRepairStats repair_level(const LevelContext& ctx, const RepairOptions& options, int j, bool project_first,
+                                 const std::vector<bool>* snapped, DomainLayout& layout, RowMatrixX3d& X) {
+  TriangleRepairOptions repair;
+  repair.sweeps = options.sweeps;
+  repair.threshold = options.threshold;
+  // Not against a staircase: its voxel steps, not the triangles, make the guard's distances.
+  repair.guard_surface_error = options.guard_finest && j == ctx.connectivity.levels() && !project_first;
+  repair.error_tolerance = options.error_tolerance;
+  if (project_first) repair.project_onto = ctx.reproject;
+  repair.fixed = snapped;
+  return repair_worst_triangles(ctx.kind, ctx.connectivity.faces[j], ctx.domain_mesh, ctx.surface_V, layout.U, X,
+                                layout.hints, repair);
+}
+
+// The fit of the finest level to the original input. A disk's rim stays on the input's rim, and
+// the snapped tips stay exactly on the input's tips (they were kept for lowering the largest
+// distance).
+SurfaceFitStats fit_finest(const LevelContext& ctx, const SurfaceFitOptions& options, int j,
+                           const std::vector<bool>& snapped, int snapped_count, RowMatrixX3d& X) {
+  const RowMatrixX3i& F = ctx.connectivity.faces[j];
+  SurfaceFitOptions fit = options;
+  fit.rounds = ctx.fit_rounds;
+  std::vector<bool> fixed =
+      ctx.kind == DomainKind::disk ? boundary_vertices(F, static_cast<int>(X.rows())) : std::vector<bool>{};
+  if (snapped_count > 0) {
+    if (fixed.empty()) fixed.assign(snapped.size(), false);
+    for (std::size_t v = 0; v < snapped.size(); ++v) fixed[v] = fixed[v] || snapped[v];
+  }
+  return fit_to_surface(F, X, *ctx.locator, fit, fixed);
+}
+
+// What the stages did, for RemeshLevel::stats.
+struct LevelRecord {
+  RelaxStats relax;
+  int snapped = 0;
+  TriangleRepairStats repair;
+  bool fitted = false;
+  SurfaceFitStats fit;
+};
+
+nlohmann::json level_stats(int j, const RemeshLevel& level, const RowMatrixX3i& F, const LevelRecord& r) {
+  nlohmann::json s;
+  s["level"] = j;
+  s["vertices"] = level.positions.rows();
+  s["faces"] = F.rows();
+  s["flipped_triangles"] = level.flipped_triangles;
+  s["seconds"] = level.seconds;
+  s["lloyd_shortened_moves"] = r.relax.lloyd.shortened_moves;
+  s["lloyd_rejected_moves"] = r.relax.lloyd.rejected_moves;
+  s["lloyd_last_mean_shift"] = r.relax.lloyd.mean_shift;
+  s["shape_moves"] = r.relax.shape_moves;
+  s["repair_moves"] = r.repair.moves;
+  s["snapped_vertices"] = r.snapped;
+  if (r.fitted)
+    s["fit"] = {{"rms_before_mm", r.fit.rms_before},          {"rms_after_mm", r.fit.rms_after},
+                {"mean_offset_mm", r.fit.mean_offset},        {"max_offset_mm", r.fit.max_offset},
+                {"clamped_vertices", r.fit.clamped_vertices}, {"held_vertices", r.fit.held_vertices}};
+  if (r.repair.moves > 0) {
+    s["repair_q_min_before"] = r.repair.q_min_before;
+    s["repair_q_min_after"] = r.repair.q_min_after;
+  }
+  return s;
+}
+
+// Quality and distance to the input, into the level's stats. Metro-style sampling of both
+// surfaces, then a uniform random subset of at most 50k points per surface: a marching-cubes
+// input has hundreds of thousands of faces, and 50k points estimate the RMS to well under 1 %
+// (the Hausdorff distance is the largest over the subset).
+void measure_level(const LevelContext& ctx, const RowMatrixX3i& F, RemeshLevel& level) {
+  nlohmann::json& s = level.stats;
+  const TriMesh mesh{level.positions, F};
+  s["quality"] = mesh_quality(mesh);
+  DistanceOptions sampling;
+  sampling.samples_per_face =
+      std::clamp(static_cast<int>(5e5 / std::max(ctx.original.num_faces(), mesh.num_faces())), 1, 10);
+  sampling.max_samples_per_mesh = kMaxStatsSamples;
+  s["distance"] = surface_distance(mesh, ctx.original, *ctx.locator, sampling);
+  s["distance"]["samples_per_face"] = sampling.samples_per_face;
+  s["distance"]["max_samples_per_mesh"] = sampling.max_samples_per_mesh;
+}
+
+// Level j: split (j > 0), relax in D and on the surface; with the full method, snap the tips
+// (finest level), repair, and fit (finest level); the projection onto the original input when a
+// simplification was parameterized. `extra_seconds` is added to the level's time.
+// \throw AlgorithmError if a triangle is flipped in D.
+RemeshLevel build_level(const LevelContext& ctx, const RemeshOptions& options, int j, DomainLayout& layout,
+                        double extra_seconds) {
+  const auto start = Clock::now();
+  const RowMatrixX3i& F = ctx.connectivity.faces[j];
+  const bool finest = j == ctx.connectivity.levels();
+  const bool full = options.relax == RelaxMode::all_vertices;
+  if (j > 0) split_level(ctx.connectivity, j, ctx.kind, layout);
+  RemeshLevel level;
+  LevelRecord r;
+  r.relax = relax_in_domain(ctx, options.relax, options.relaxation, j, layout, level.positions);
+  if (full && options.relaxation.surface_iterations > 0)
+    r.relax.shape_moves += relax_on_surface(ctx, options.relaxation, j, layout, level.positions);
+  std::vector<bool> snapped;
+  if (full && options.snap.max_snaps > 0 && finest)
+    r.snapped = snap_tips(ctx, options.snap, j, layout, level.positions, snapped);
+  // Onto the original input before the repair, so that the repair sees (and keeps) the final
+  // triangles: the projection onto a marching-cubes staircase shears a few of them.
+  const bool project_first = ctx.reproject && options.repair.after_reprojection;
+  if (project_first) reproject_onto(*ctx.reproject, level.positions);
+  if (full && options.repair.sweeps > 0 && (options.repair.coarse_levels || finest))
+    r.repair = repair_level(ctx, options.repair, j, project_first, r.snapped > 0 ? &snapped : nullptr, layout,
+                            level.positions);
+  report(options.progress, "level " + std::to_string(j), 0.5);
+  if (ctx.reproject && !project_first) reproject_onto(*ctx.reproject, level.positions);
+  const int flipped = count_flipped(layout.U, F);
+  if (flipped > 0)
+    throw AlgorithmError("level " + std::to_string(j) + " has " + std::to_string(flipped) +
+                         " flipped triangles in the domain; the surface cannot be remeshed well");
+  r.fitted = ctx.fit_rounds > 0 && finest;
+  if (r.fitted) r.fit = fit_finest(ctx, options.fit, j, snapped, r.snapped, level.positions);
+  level.domain_positions = layout.U;
+  level.flipped_triangles = flipped;
+  level.seconds = seconds_since(start) + extra_seconds;
+  level.stats = level_stats(j, level, F, r);
+  if (options.compute_stats) measure_level(ctx, F, level);
+  return level;
+}
+
+}  // namespace
+
+RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
+  check_options(options);
+  if (input.empty()) throw InputError("the mesh has no faces");
+  RemeshResult result;
+  const auto start = Clock::now();
+  Resolution resolution = initial_resolution(options);
+  const PreparedInput prepared = prepare_input(input, options.simplify, resolution, options.progress, start);
+  // Like the snap and the repair, the fit is part of the full method only: --no-relax and
+  // --strict stay the paper's baseline and exact method, with every vertex on the input.
+  const int fit_rounds = options.relax == RelaxMode::all_vertices ? options.fit.rounds : 0;
+  const bool needs_locator =
+      prepared.simplified || fit_rounds > 0 || options.compute_stats || options.keep_input_locator;
+  const MappedInput mapped = map_onto_domain(prepared, options.sphere_map, needs_locator, options.progress);
+  const Parameterization& param = mapped.param;
+  result.input_locator = mapped.locator;
+  result.domain = param.kind == DomainKind::sphere ? "sphere" : "disk";
+  result.parameterization = parameterization_summary(mapped, prepared, start);
+
+  const auto base_start = Clock::now();
+  const DomainMesh domain_mesh(param.domain, param.surface.F);
+  report(options.progress, "base mesh", 0);
+  const SizingFields sizing =
+      sizing_fields(param.surface, options.sizing, options.base, options.levels != 0, resolution);
+  const BaseMesh base = build_base(param, options.base, sizing, resolution, result);
+  const DensityField density = lloyd_density(domain_mesh, param, sizing, options.sizing);
+  DomainLayout layout = base_layout(base, domain_mesh);
+  const LevelContext context{param.kind,           domain_mesh,
+                             param.surface.V,      density,
+                             sizing.wanted,        prepared.original,
+                             mapped.locator.get(), prepared.simplified ? mapped.locator.get() : nullptr,
+                             result.connectivity,  fit_rounds};
+  const double setup_seconds = seconds_since(base_start);
+
+  for (int j = 0; j <= resolution.levels; ++j) {
+    result.levels.push_back(build_level(context, options, j, layout, j == 0 ? setup_seconds : 0.0));
     report(options.progress, "level " + std::to_string(j), 1.0);
   }
   return result;
@@ -368,27 +512,30 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   nlohmann::json j;
   j["domain"] = result.domain;
   j["levels"] = result.connectivity.levels();
-  j["relax"] = relax_name(options.relax);
-  j["density_exponent"] = options.density_exponent;
-  j["curvature_weight"] = options.curvature_weight;
-  j["curvature_exponent"] = options.curvature_exponent;
-  j["surface_relax_iterations"] = options.relax == RelaxMode::all_vertices ? options.surface_relax_iterations : 0;
-  j["surface_relax_quality_floor"] = options.surface_relax_quality_floor;
-  j["smooth_rim"] = options.smooth_rim;
-  j["base_density_exponent"] = options.base_density_exponent;
-  j["repair_after_reprojection"] = options.repair_after_reprojection;
-  j["snap_tips"] = options.relax == RelaxMode::all_vertices ? options.snap_tips : 0;
-  j["fit_rounds"] = options.relax == RelaxMode::all_vertices ? options.fit_rounds : 0;
-  j["base_density_smoothing"] = options.base_density_smoothing;
-  j["max_base_bend"] = options.max_base_bend;
-  j["lloyd_iterations"] = options.lloyd_iterations;
-  j["shape_iterations"] = options.relax == RelaxMode::all_vertices ? options.shape_iterations : 0;
-  j["repair_sweeps"] = options.relax == RelaxMode::all_vertices ? options.repair_sweeps : 0;
-  j["repair_threshold"] = options.repair_threshold;
-  j["repair_coarse_levels"] = options.repair_coarse_levels;
-  j["repair_guard_finest"] = options.repair_guard_finest;
-  j["repair_error_tolerance"] = options.repair_error_tolerance;
-  j["rim_min_triangles"] = options.rim_min_triangles;
+  // The options as `mrsnake remesh --config` reads them: the run can be repeated exactly.
+  j["options"] = options;
+  // The method's main settings at the top level too (the report page shows some of them).
+  j["relax"] = options.relax;
+  j["density_exponent"] = options.sizing.density_exponent;
+  j["curvature_weight"] = options.sizing.curvature_weight;
+  j["curvature_exponent"] = options.sizing.curvature_exponent;
+  j["surface_relax_iterations"] = options.relax == RelaxMode::all_vertices ? options.relaxation.surface_iterations : 0;
+  j["surface_relax_quality_floor"] = options.relaxation.surface_quality_floor;
+  j["smooth_rim"] = options.relaxation.smooth_rim;
+  j["base_density_exponent"] = options.base.density_exponent;
+  j["repair_after_reprojection"] = options.repair.after_reprojection;
+  j["snap_tips"] = options.relax == RelaxMode::all_vertices ? options.snap.max_snaps : 0;
+  j["fit_rounds"] = options.relax == RelaxMode::all_vertices ? options.fit.rounds : 0;
+  j["base_density_smoothing"] = options.base.density_smoothing;
+  j["max_base_bend"] = options.base.max_bend;
+  j["lloyd_iterations"] = options.relaxation.lloyd_iterations;
+  j["shape_iterations"] = options.relax == RelaxMode::all_vertices ? options.relaxation.shape_iterations : 0;
+  j["repair_sweeps"] = options.relax == RelaxMode::all_vertices ? options.repair.sweeps : 0;
+  j["repair_threshold"] = options.repair.threshold;
+  j["repair_coarse_levels"] = options.repair.coarse_levels;
+  j["repair_guard_finest"] = options.repair.guard_finest;
+  j["repair_error_tolerance"] = options.repair.error_tolerance;
+  j["rim_min_triangles"] = options.base.rim_min_triangles;
   j["parameterization"] = result.parameterization;
   double total = result.parameterization.value("seconds", 0.0);
   nlohmann::json per_level = nlohmann::json::array();

@@ -460,8 +460,8 @@ TEST(CommandLine, NonFiniteNumbersAreUsageErrors) {
   // CLI11's ranges let nan through (every comparison with it is false); every FLOAT option of
   // every command must refuse nan and inf with a one-line usage error (exit 2) naming the option.
   const std::string out = mrsnake::test::scratch_dir("non-finite").string();
-  for (const std::string& args : {"synth -o " + out + "/s --snr inf", "synth -o " + out + "/s --blur -inf",
-                                  "build-model --labels l.nii.gz --label 1 -o " + out + "/m --mc-spacing nan"}) {
+  for (const std::string& args :
+       {"synth -o " + out + "/s --snr inf", "synth -o " + out + "/s --blur -inf", "synth -o " + out + "/s --snr nan"}) {
     const auto r = run_mrsnake(args);
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.output;
     EXPECT_NE(r.output.find("needs a finite number"), std::string::npos) << args << "\n" << r.output;

@@ -158,7 +158,7 @@ TEST(BuildModel, APoorFitIsRefusedUnlessAllowed) {
 
 TEST(BuildModel, ThePresetKeepsTheVerticesOnTheReferenceSurface) {
   const RemeshOptions preset = model_remesh_preset();
-  EXPECT_EQ(preset.fit_rounds, 0);
-  EXPECT_EQ(BuildModelOptions{}.remesh.fit_rounds, 0);
-  EXPECT_GT(preset.curvature_weight, RemeshOptions{}.curvature_weight);
+  EXPECT_EQ(preset.fit.rounds, 0);
+  EXPECT_EQ(BuildModelOptions{}.remesh.fit.rounds, 0);
+  EXPECT_GT(preset.sizing.curvature_weight, RemeshOptions{}.sizing.curvature_weight);
 }

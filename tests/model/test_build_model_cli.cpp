@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,13 @@ Volume labels_where(std::array<std::size_t, 3> size, float label, Inside inside)
       for (std::size_t i = 0; i < size[0]; ++i)
         if (inside(static_cast<double>(i), static_cast<double>(j), static_cast<double>(k))) v.at(i, j, k) = label;
   return v;
+}
+
+/// " --config FILE" for options given as JSON, written to dir/name.json.
+std::string config_arg(const std::filesystem::path& dir, const std::string& name, const nlohmann::json& options) {
+  const auto path = dir / (name + ".json");
+  std::ofstream(path) << options.dump();
+  return " --config " + path.string();
 }
 
 /// `mrsnake -q build-model ARGS` must exit with exit_code, say `mentions`, and leave no model at `model`.
@@ -111,19 +119,29 @@ TEST(BuildModelCli, BuildsAModelThatModelInfoAccepts) {
   ASSERT_EQ(info.exit_code, 0) << info.output;
   EXPECT_TRUE(nlohmann::json::parse(info.output)["synthesis"]["ok"].get<bool>());
 
-  // A model's vertices stay on the reference surface unless --fit-rounds asks for the fit.
+  // A model's vertices stay on the reference surface unless remesh.fit.rounds asks for the fit.
   EXPECT_EQ(m.remesh_quality["fit_rounds"].get<int>(), 0);
   EXPECT_FALSE(m.remesh_quality["per_level"].back().contains("fit"));
 
-  // --sphere-map halves and --fit-rounds reach the remesher and model.json records them.
+  // The sphere map and the fit rounds of a config reach the remesher and model.json records them.
   const std::string halves = (dir / "halves.model").string();
+  const nlohmann::json config = {{"remesh", {{"sphere_map", "two_halves"}, {"fit", {{"rounds", 1}}}}}};
   const auto built_halves = run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + halves +
-                                        " --faces 2048 --sphere-map halves --fit-rounds 1");
+                                        " --faces 2048" + config_arg(dir, "halves", config));
   ASSERT_EQ(built_halves.exit_code, 0) << built_halves.output;
   const ShapeModel fitted = load_model(halves, {true});
   EXPECT_EQ(fitted.remesh_quality["parameterization"]["sphere_map"], "two_halves");
   EXPECT_EQ(fitted.remesh_quality["fit_rounds"].get<int>(), 1);
   EXPECT_TRUE(fitted.remesh_quality["per_level"].back().contains("fit"));
+  EXPECT_EQ(fitted.build_options["remesh"]["fit"]["rounds"].get<int>(), 1);
+
+  // The recorded options build the same model again, bit for bit.
+  const std::string again = (dir / "again.model").string();
+  const auto rebuilt = run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + again +
+                                   config_arg(dir, "again", fitted.build_options));
+  ASSERT_EQ(rebuilt.exit_code, 0) << rebuilt.output;
+  EXPECT_EQ(read_all(std::filesystem::path(again) / "details.bin"),
+            read_all(std::filesystem::path(halves) / "details.bin"));
 }
 
 TEST(BuildModelCli, McSpacingZeroUsesTheVoxelSurface) {
@@ -134,8 +152,10 @@ TEST(BuildModelCli, McSpacingZeroUsesTheVoxelSurface) {
   ASSERT_EQ(mc.exit_code, 0) << mc.output;
   const int voxel_faces = nlohmann::json::parse(mc.output)["faces"].get<int>();
   const auto run = [&](const std::string& spacing) {
-    const auto r = run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " +
-                               (dir / ("m" + spacing)).string() + " --faces 2048 --mc-spacing " + spacing + " --json");
+    const auto r =
+        run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + (dir / ("m" + spacing)).string() +
+                    " --faces 2048 --json" +
+                    config_arg(dir, "spacing" + spacing, {{"surface", {{"mc_spacing_mm", std::stod(spacing)}}}}));
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return nlohmann::json::parse(r.output);
   };
@@ -143,10 +163,10 @@ TEST(BuildModelCli, McSpacingZeroUsesTheVoxelSurface) {
   const int coarse = run("2")["input_faces"].get<int>();
   EXPECT_LT(coarse * 2, voxel_faces);
   EXPECT_GT(coarse, 200);
-  EXPECT_EQ(
-      run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + (dir / "bad").string() + " --mc-spacing -1")
-          .exit_code,
-      2);
+  EXPECT_EQ(run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + (dir / "bad").string() +
+                        config_arg(dir, "bad", {{"surface", {{"mc_spacing_mm", 1000}}}}))
+                .exit_code,
+            3);
 
   // A coarse image is not resampled: by default its voxels' own surface is used.
   Volume coarse_grid = read_volume(labels);
@@ -173,14 +193,22 @@ TEST(BuildModelCli, BadInputsGetExitCodes) {
   EXPECT_FALSE(std::filesystem::exists(model));
   EXPECT_EQ(
       run_mrsnake("-q build-model --labels " + (dir / "none.nii.gz").string() + " --label 3 -o " + model).exit_code, 3);
-  EXPECT_EQ(run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --predict cubic").exit_code,
-            2);
-  EXPECT_EQ(
-      run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + model + " --levels 3 --faces 100").exit_code,
-      2);
-  expect_refused("--labels " + labels + " --label 3 -o " + model + " --image " + labels + " --profile-alignment middle",
-                 2, "--profile-alignment", model);
-  expect_refused("--labels " + labels + " --label 3 -o " + model + " --profile-alignment edges", 2, "--image", model);
+  expect_refused(
+      "--labels " + labels + " --label 3 -o " + model + config_arg(dir, "cubic", {{"wavelet", {{"predict", "cubic"}}}}),
+      3, "\"linear\", \"butterfly\"", model);
+  EXPECT_EQ(run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + (dir / "faces.model").string() +
+                        " --faces 100" + config_arg(dir, "levels", {{"levels", 3}, {"faces", 200}}))
+                .exit_code,
+            0);  // --faces replaces the file's levels
+  expect_refused(
+      "--labels " + labels + " --label 3 -o " + model + config_arg(dir, "both", {{"levels", 3}, {"faces", 200}}), 3,
+      "faces", model);
+  expect_refused("--labels " + labels + " --label 3 -o " + model + " --image " + labels +
+                     config_arg(dir, "middle", {{"appearance", {{"alignment", "middle"}}}}),
+                 3, "alignment", model);
+  expect_refused("--labels " + labels + " --label 3 -o " + model + config_arg(dir, "typo", {{"surfaces", 1}}), 3,
+                 "unknown options key 'surfaces'", model);
+  expect_refused("--labels " + labels + " --label 3 -o " + model + " --faces 100 --levels 3", 2, "--levels", model);
 }
 
 TEST(BuildModelCli, ProfileAlignmentIsChosenAndReported) {
@@ -194,7 +222,8 @@ TEST(BuildModelCli, ProfileAlignmentIsChosenAndReported) {
     return nlohmann::json::parse(r.output)["profile_alignment"];
   };
   const nlohmann::json automatic = summary_of("auto.model", ""),
-                       labels_kept = summary_of("labels.model", " --profile-alignment labels");
+                       labels_kept = summary_of("labels.model",
+                                                config_arg(dir, "labels", {{"appearance", {{"alignment", "labels"}}}}));
   EXPECT_EQ(automatic["centred_on"], "edges");
   EXPECT_GE(automatic["levels_aligned"].get<int>(), 1);
   EXPECT_GT(automatic["mean_abs_shift_mm"].get<double>(), 0.0);
@@ -288,8 +317,9 @@ TEST(BuildModelCli, LongTubesArePuncturedInTheMiddleAndTheTooLongMappedHierarchi
   // is built on the hierarchical map, with no flipped triangle at any level.
   const auto dir = scratch_dir("build-model-cli-tube");
   const std::string model = (dir / "tube.model").string();
-  const auto built = run_mrsnake("-q build-model --labels " + write_tube_labels(dir, 70, 2.5) + " --label 1 -o " +
-                                 model + " --faces 2048 --mc-spacing 1.2 --json");
+  const auto built =
+      run_mrsnake("-q build-model --labels " + write_tube_labels(dir, 70, 2.5) + " --label 1 -o " + model +
+                  " --faces 2048 --json" + config_arg(dir, "mc12", {{"surface", {{"mc_spacing_mm", 1.2}}}}));
   ASSERT_EQ(built.exit_code, 0) << built.output;
   const auto summary = nlohmann::json::parse(built.output);
   EXPECT_EQ(summary["faces"], 2048);
@@ -298,7 +328,7 @@ TEST(BuildModelCli, LongTubesArePuncturedInTheMiddleAndTheTooLongMappedHierarchi
   std::filesystem::remove_all(model);
 
   const auto r = run_mrsnake("-q build-model --labels " + write_tube_labels(dir, 100, 2.5) + " --label 1 -o " + model +
-                             " --faces 2048 --mc-spacing 1.2");
+                             " --faces 2048" + config_arg(dir, "mc12", {{"surface", {{"mc_spacing_mm", 1.2}}}}));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const ShapeModel long_tube = load_model(model, {true});
   const nlohmann::json& param = long_tube.remesh_quality["parameterization"];
@@ -365,16 +395,19 @@ TEST(BuildModelCli, AModelThatLostItsOrganIsRefusedUnlessAllowed) {
   const std::string labels = (dir / "ball.nii.gz").string();
   write_volume(labels, v, VoxelType::uint8);
   const std::string model = (dir / "ball.model").string();
-  expect_refused("--labels " + labels + " --label 1 -o " + model + " --mc-spacing 1.2", 5,
-                 "the model's finest level covers its label with Dice ", model);
-  const auto refused =
-      run_mrsnake("-q build-model --labels " + labels + " --label 1 -o " + model + " --mc-spacing 1.2");
-  EXPECT_NE(refused.output.find("give a smaller --mc-spacing (e.g. 0.15)"), std::string::npos) << refused.output;
+  expect_refused("--labels " + labels + " --label 1 -o " + model +
+                     config_arg(dir, "mc12", {{"surface", {{"mc_spacing_mm", 1.2}}}}),
+                 5, "the model's finest level covers its label with Dice ", model);
+  const auto refused = run_mrsnake("-q build-model --labels " + labels + " --label 1 -o " + model +
+                                   config_arg(dir, "mc12", {{"surface", {{"mc_spacing_mm", 1.2}}}}));
+  EXPECT_NE(refused.output.find("give a smaller surface.mc_spacing_mm with --config (e.g. 0.15)"), std::string::npos)
+      << refused.output;
   EXPECT_NE(refused.output.find("--allow-poor-fit"), std::string::npos) << refused.output;
 
   // Allowed: written, with a warning and the fit in model.json.
-  const auto allowed = run_mrsnake("-q build-model --labels " + labels + " --label 1 -o " + model +
-                                   " --mc-spacing 1.2 --allow-poor-fit");
+  const auto allowed =
+      run_mrsnake("-q build-model --labels " + labels + " --label 1 -o " + model +
+                  config_arg(dir, "mc12", {{"surface", {{"mc_spacing_mm", 1.2}}}}) + " --allow-poor-fit");
   ASSERT_EQ(allowed.exit_code, 0) << allowed.output;
   EXPECT_NE(allowed.output.find("warning: the model's finest level covers its label with Dice "), std::string::npos)
       << allowed.output;

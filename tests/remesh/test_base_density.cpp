@@ -277,13 +277,13 @@ TEST(FeatureSnap, KeepsSnapsOnlyIfTheLargestDistanceDrops) {
     }
   EXPECT_GT(kept, 0);
 }
-// snap_tips = 0 in the remesher: no vertex snaps (snapped_vertices 0 on every level).
+// snap.max_snaps = 0 in the remesher: no vertex snaps (snapped_vertices 0 on every level).
 TEST(FeatureSnap, RemeshWithZeroSnapTipsSnapsNothing) {
   RemeshOptions o;
   o.levels = 1;
   o.base_vertices = 20;
   o.compute_stats = false;
-  o.snap_tips = 0;
+  o.snap.max_snaps = 0;
   const RemeshResult r = remesh(ellipsoid(3), o);
   for (const RemeshLevel& level : r.levels) EXPECT_EQ(level.stats["snapped_vertices"].get<int>(), 0);
 }

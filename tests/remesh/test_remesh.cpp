@@ -126,7 +126,7 @@ TEST(Remesh, EllipsoidNestsExactlyWithoutFlipsInEveryModeAndSphereMap) {
 TEST(Remesh, FineInputIsSimplifiedThenProjectedBackOntoIt) {
   const TriMesh input = ellipsoid(5);  // 20480 faces
   RemeshOptions o = small_options(2, 20);
-  o.simplify_above_faces = 2000;
+  o.simplify.above_faces = 2000;
   const RemeshResult r = remesh(input, o);
   EXPECT_LT(r.parameterization["parameterized_faces"].get<int>(), input.num_faces());
   EXPECT_GE(r.parameterization["parameterized_faces"].get<int>(), 2000);
@@ -445,9 +445,9 @@ TEST(TriangleRepair, RaisesEveryLevelsWorstTriangleAndKeepsTheRimOnTheCircle) {
   for (const TriMesh& input : {spherical_cap(4), ellipsoid(4)}) {
     RemeshOptions on = small_options(3, 24);
     on.compute_stats = true;
-    on.fit_rounds = 0;  // the level's Q is then the repair's own (the fit moves the finest level)
+    on.fit.rounds = 0;  // the level's Q is then the repair's own (the fit moves the finest level)
     RemeshOptions off = on;
-    off.repair_sweeps = 0;
+    off.repair.sweeps = 0;
     const RemeshResult a = remesh(input, on), b = remesh(input, off);
     expect_nested_and_valid(a, input, a.domain == "sphere");
     int moves = 0;

@@ -91,7 +91,7 @@ TEST(BendBound, ALongTubeGrowsTheBaseAndTheTrianglesGetRounder) {
   RemeshOptions options;
   options.target_faces = 2048;
   RemeshOptions unbounded = options;
-  unbounded.max_base_bend = 0;
+  unbounded.base.max_bend = 0;
   const RemeshResult grown = remesh(tube, options);
   const RemeshResult plain = remesh(tube, unbounded);
   EXPECT_EQ(plain.parameterization["base_vertices"], 66);

@@ -143,9 +143,9 @@ TEST(SurfaceFit, RemeshFitsOnlyTheFinestLevelAndItGetsCloser) {
   RemeshOptions options;
   options.levels = 2;
   options.base_vertices = 24;
-  options.fit_rounds = 0;
+  options.fit.rounds = 0;
   const RemeshResult on_surface = remesh(ellipsoid, options);
-  options.fit_rounds = 1;
+  options.fit.rounds = 1;
   const RemeshResult fitted = remesh(ellipsoid, options);
   ASSERT_EQ(fitted.levels.size(), 3u);
   for (int j = 0; j < 2; ++j) {

@@ -210,7 +210,7 @@ TEST(SurfaceRelaxation, RimVerticesSlideAlongTheRimAndStayOnTheCircle) {
 }
 
 // The surface relaxation runs whenever all vertices relax, also without shape rounds: with
-// shape_iterations = 0 it still moves vertices (shape_moves counts them, and the positions
+// relaxation.shape_iterations = 0 it still moves vertices (shape_moves counts them, and the positions
 // differ from those without it).
 TEST(SurfaceRelaxation, RunsWithoutShapeIterations) {
   const TriMesh input = ellipsoid(4);
@@ -218,12 +218,12 @@ TEST(SurfaceRelaxation, RunsWithoutShapeIterations) {
   o.levels = 1;
   o.base_vertices = 20;
   o.compute_stats = false;
-  o.shape_iterations = 0;
-  o.snap_tips = 0;
-  o.repair_sweeps = 0;
-  o.surface_relax_iterations = 0;
+  o.relaxation.shape_iterations = 0;
+  o.snap.max_snaps = 0;
+  o.repair.sweeps = 0;
+  o.relaxation.surface_iterations = 0;
   const RemeshResult without = remesh(input, o);
-  o.surface_relax_iterations = 3;
+  o.relaxation.surface_iterations = 3;
   const RemeshResult with = remesh(input, o);
   for (int j = 0; j <= 1; ++j) {
     SCOPED_TRACE(j);
