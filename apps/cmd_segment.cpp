@@ -21,6 +21,8 @@
 #include <vector>
 
 #include "apps/cli.h"
+#include "apps/exit_codes.h"
+#include "apps/hints.h"
 #include "apps/report/segment_page.h"
 #include "mesh/atomic_file.h"
 #include "mesh/distance.h"
@@ -445,7 +447,7 @@ nlohmann::json batch_row(const std::string& image, const std::string& output, co
     if (rep.contains("registration"))
       row["registration"] = rep["registration"].value("accepted", false) ? "accepted" : "rejected";
   } catch (const Error& e) {
-    failed(e.what(), e.code());
+    failed(message_with_hint(e, "segment-batch"), exit_code_of(e));
   } catch (const std::bad_alloc&) {
     failed("out of memory", ExitCode::failed);
   } catch (const std::exception& e) {  // a bug; the other images may still succeed

@@ -4,6 +4,8 @@
 #include <iostream>
 
 #include "apps/cli.h"
+#include "apps/exit_codes.h"
+#include "apps/hints.h"
 #include "mesh/atomic_file.h"
 #include "mesh/errors.h"
 
@@ -36,16 +38,18 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
-    return code == 0 ? 0 : static_cast<int>(ExitCode::usage);
+    return code == 0 ? 0 : static_cast<int>(cli::ExitCode::usage);
   } catch (const Error& e) {
-    std::cerr << "mrsnake: error: " << e.what() << '\n';
-    return static_cast<int>(e.code());
+    const auto commands = app.get_subcommands();
+    std::cerr << "mrsnake: error: " << cli::message_with_hint(e, commands.empty() ? "" : commands[0]->get_name())
+              << '\n';
+    return static_cast<int>(cli::exit_code_of(e));
   } catch (const std::bad_alloc&) {
     std::cerr << "mrsnake: error: out of memory; try a smaller input or fewer levels\n";
-    return static_cast<int>(ExitCode::failed);
+    return static_cast<int>(cli::ExitCode::failed);
   } catch (const std::exception& e) {
     std::cerr << "mrsnake: internal error: " << e.what() << " (please report this)\n";
-    return static_cast<int>(ExitCode::internal);
+    return static_cast<int>(cli::ExitCode::internal);
   }
   return 0;
 }

@@ -104,7 +104,8 @@ SegmentationScores evaluate_segmentation(const Volume& seg, const Volume& truth,
   }
   if (r.truth_voxels == 0)
     throw InputError("the truth has no voxel with label " + std::to_string(truth_label) +
-                     " (labels present: " + labels_present(truth) + "); pick one with --label");
+                         " (labels present: " + labels_present(truth) + ")",
+                     Remedy::choose_label);
   const double voxel_mm3 = seg.spacing[0] * seg.spacing[1] * seg.spacing[2];
   r.seg_volume_mm3 = r.seg_voxels * voxel_mm3;
   r.truth_volume_mm3 = r.truth_voxels * voxel_mm3;

@@ -235,8 +235,9 @@ std::vector<std::pair<int, int>> self_intersecting_face_pairs(const TriMesh& mes
     const Face face = sm.add_face(vertices[a], vertices[b], vertices[c]);
     if (face == SurfaceMesh::null_face())
       throw TopologyError("face " + std::to_string(f) +
-                          " makes the mesh non-manifold or inconsistently oriented, so its self-intersections "
-                          "cannot be counted; check it with 'mrsnake info'");
+                              " makes the mesh non-manifold or inconsistently oriented, so its self-intersections "
+                              "cannot be counted",
+                          Remedy::inspect_mesh);
     original.push_back(f);
   }
   std::vector<std::pair<Face, Face>> pairs;

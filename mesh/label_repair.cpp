@@ -88,12 +88,11 @@ Volume keep_label_part(const Volume& labels, int label, int rank) {
   by_size->SetSortByObjectSize(true);
   by_size->Update();
   const auto parts = static_cast<int>(by_size->GetNumberOfObjects());
-  if (parts == 0)
-    throw InputError("label " + std::to_string(label) + " has no voxel; pick a label that is present with --label");
+  if (parts == 0) throw InputError("label " + std::to_string(label) + " has no voxel", Remedy::choose_label);
   if (rank > parts)
     throw InputError("label " + std::to_string(label) + " has " + std::to_string(parts) + " connected part" +
-                     (parts == 1 ? "" : "s") + ", so there is no part " + std::to_string(rank) +
-                     "; give --component 1" + (parts == 1 ? "" : " to " + std::to_string(parts)));
+                         (parts == 1 ? "" : "s") + ", so there is no part " + std::to_string(rank),
+                     Remedy::choose_component, parts);
 
   Volume out = labels;
   const unsigned int* p = by_size->GetOutput()->GetBufferPointer();

@@ -142,8 +142,9 @@ LabelSurface extract_label_surface(const Volume& labels, int label, const LabelS
                                    const ProgressFn& progress) {
   const auto target = static_cast<float>(label);
   if (std::none_of(labels.data.begin(), labels.data.end(), [&](float v) { return v == target; }))
-    throw InputError("label " + std::to_string(label) + " is not present in the volume (labels present: " +
-                     labels_present(labels) + "); choose one of those with --label");
+    throw InputError("label " + std::to_string(label) +
+                         " is not present in the volume (labels present: " + labels_present(labels) + ")",
+                     Remedy::choose_label);
   report(progress, "marching cubes", 0.0);
   LabelSurface result = extract_once(labels, label, options, progress);
   result.genus_before_repair = topology_report(result.mesh).genus;

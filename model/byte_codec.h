@@ -48,16 +48,16 @@ class ByteWriter {
 /// Reads values little-endian from a byte buffer it does not own.
 class ByteReader {
  public:
-  /// Reads from `position`; past the end it throws InputError(truncated_message).
-  ByteReader(const std::vector<std::uint8_t>& bytes, std::size_t position, std::string truncated_message)
-      : bytes_(bytes), position_(position), truncated_message_(std::move(truncated_message)) {}
+  /// Reads from `position`; past the end it throws `truncated`.
+  ByteReader(const std::vector<std::uint8_t>& bytes, std::size_t position, InputError truncated)
+      : bytes_(bytes), position_(position), truncated_(std::move(truncated)) {}
 
   /// \pre T is an arithmetic type of at most 8 bytes.
   /// \throw InputError if fewer than sizeof(T) bytes are left.
   template <class T>
   T get() {
     static_assert(std::is_arithmetic_v<T> && sizeof(T) <= 8, "only numbers have a byte encoding");
-    if (position_ + sizeof(T) > bytes_.size()) throw InputError(truncated_message_);
+    if (position_ + sizeof(T) > bytes_.size()) throw truncated_;
     byte_codec_detail::UnsignedOf<T> bits = 0;
     for (std::size_t i = 0; i < sizeof(T); ++i)
       bits |= static_cast<decltype(bits)>(static_cast<decltype(bits)>(bytes_[position_ + i]) << (8 * i));
@@ -72,7 +72,7 @@ class ByteReader {
  private:
   const std::vector<std::uint8_t>& bytes_;
   std::size_t position_;
-  std::string truncated_message_;
+  InputError truncated_;
 };
 
 }  // namespace mrsnake

@@ -86,7 +86,7 @@ void decode_details(const std::vector<std::uint8_t>& bytes, const std::string& w
   if (bytes.size() < kHeaderBytes + 8)
     throw fail("is truncated (" + std::to_string(bytes.size()) + " bytes, shorter than its header)");
   if (std::memcmp(bytes.data(), kMagic, 8) != 0) throw fail("is not a mrsnake details file (bad magic bytes)");
-  ByteReader r(bytes, 0, fail("is truncated").what());
+  ByteReader r(bytes, 0, fail("is truncated"));
   r.get<std::uint64_t>();  // magic
   const std::uint32_t version = r.get<std::uint32_t>();
   if (version > kDetailsVersion)
@@ -305,8 +305,7 @@ nlohmann::json read_model_manifest(const std::string& folder) {
   const fs::path dir = normalized_folder(folder);
   std::error_code ec;
   if (!fs::exists(dir, ec)) throw InputError("model folder '" + folder + "' does not exist; check the path");
-  if (!fs::is_directory(dir, ec))
-    throw InputError("'" + folder + "' is not a model folder (a model is a folder made by 'mrsnake build-model')");
+  if (!fs::is_directory(dir, ec)) throw InputError("'" + folder + "' is not a model folder", Remedy::make_model);
   if (!fs::is_regular_file(dir / kManifest, ec))
     throw InputError("model '" + folder + "' has no model.json; it is incomplete or not a model: rebuild it");
   const std::vector<std::uint8_t> bytes = read_bytes(dir / kManifest);

@@ -16,8 +16,7 @@ constexpr char kAppearanceMagic[8] = {'M', 'R', 'S', 'A', 'P', 'P', '0', '2'};
 // Version 01 differs only in having no centre byte per level.
 constexpr char kAppearanceMagicVersion01[8] = {'M', 'R', 'S', 'A', 'P', 'P', '0', '1'};
 
-constexpr const char* kAppearanceTruncated =
-    "the model's appearance section is truncated; rebuild the model with build-model --image";
+constexpr const char* kAppearanceTruncated = "the model's appearance section is truncated";
 }  // namespace
 
 std::vector<std::uint8_t> serialize_appearance(const Appearance& a) {
@@ -44,7 +43,7 @@ Appearance deserialize_appearance(const std::vector<std::uint8_t>& bytes) {
   const bool version01 = bytes.size() >= 8 && std::memcmp(bytes.data(), kAppearanceMagicVersion01, 8) == 0;
   if (bytes.size() < 8 || (!version01 && std::memcmp(bytes.data(), kAppearanceMagic, 8) != 0))
     throw InputError("the model's appearance section is not in a format this build reads; rebuild the model");
-  ByteReader r(bytes, 8, kAppearanceTruncated);
+  ByteReader r(bytes, 8, InputError(kAppearanceTruncated, Remedy::rebuild_model_with_image));
   Appearance a;
   a.half_length = r.get<std::int32_t>();
   const int levels = r.get<std::int32_t>();
@@ -93,7 +92,7 @@ constexpr std::size_t kHeaderBytes = 8 + 4 + 3 * 4 + 15 * 8;  // magic, version,
 constexpr std::uint32_t kMaxAxis = 1024;
 
 InputError defect(const std::string& what) {
-  return InputError("the model's reference image section " + what + "; rebuild the model with build-model --image");
+  return InputError("the model's reference image section " + what, Remedy::rebuild_model_with_image);
 }
 
 }  // namespace
@@ -113,7 +112,7 @@ std::vector<std::uint8_t> serialize_reference_image(const Volume& r) {
 Volume deserialize_reference_image(const std::vector<std::uint8_t>& bytes) {
   if (bytes.size() < 8 || std::memcmp(bytes.data(), kReferenceMagic, 8) != 0)
     throw defect("is not in a format this build reads");
-  ByteReader r(bytes, 8, defect("is truncated").what());
+  ByteReader r(bytes, 8, defect("is truncated"));
   if (r.get<std::uint32_t>() != kReferenceVersion) throw defect("has a version this build does not read");
   Volume v;
   for (int a = 0; a < 3; ++a) {

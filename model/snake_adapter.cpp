@@ -19,7 +19,7 @@ std::vector<RowMatrixX3d> model_levels(const ShapeModel& model) {
 }  // namespace
 
 SnakeModel snake_model_from(const ShapeModel& model) {
-  if (model.base.rows() == 0) throw InputError("the model has no base mesh; rebuild it with mrsnake build-model");
+  if (model.base.rows() == 0) throw InputError("the model has no base mesh", Remedy::rebuild_model);
   SnakeModel m;
   m.connectivity = model.connectivity();
   m.levels = model_levels(model);

@@ -58,7 +58,8 @@ void triangulate_samples(const Parameterization& param, const std::vector<bool>&
   std::set<int> used(base.faces.data(), base.faces.data() + base.faces.size());
   if (static_cast<int>(used.size()) != m)
     throw AlgorithmError("the base mesh does not use all of its " + std::to_string(m) +
-                         " vertices; the parameterization is too distorted for this base size (try another --faces)");
+                             " vertices; the parameterization is too distorted for this base size",
+                         Remedy::other_resolution);
   if (const int flipped = count_flipped(base.domain, base.faces); flipped > 0)
     throw AlgorithmError("the base mesh has " + std::to_string(flipped) + " flipped triangles in the domain");
   if (param.sphere_map == SphereMap::hierarchical) {

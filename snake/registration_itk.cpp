@@ -301,10 +301,10 @@ RegistrationResult register_similarity(const Volume& fixed, const Volume& moving
   std::array<long, 3> lo{}, hi{};
   if (!index_box_of_points(moving, corners, o.moving_margin_fraction, o.moving_margin_voxels * fixed.max_spacing(), lo,
                            hi))
-    throw InputError("the model's reference image does not overlap the image; use another --init");
+    throw InputError("the model's reference image does not overlap the image", Remedy::other_initialization);
   for (int a = 0; a < 3; ++a)
     if (hi[a] - lo[a] < 3)
-      throw InputError("the model's reference image barely overlaps the image; use another --init");
+      throw InputError("the model's reference image barely overlaps the image", Remedy::other_initialization);
   Volume moving_crop = crop_volume(moving, lo, hi);
   if (o.moving_intensity_scale != 1.0 || o.moving_intensity_offset != 0.0)
     for (float& v : moving_crop.data) v = static_cast<float>(o.moving_intensity_scale * v + o.moving_intensity_offset);

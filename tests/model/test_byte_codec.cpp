@@ -30,7 +30,7 @@ TEST(ByteCodec, ReadsBackWhatItWroteAndRefusesToReadPastTheEnd) {
   w.put<std::uint64_t>(0x0123456789ABCDEFull);
   w.put<float>(3.25f);
   const std::vector<std::uint8_t> bytes = w.take();
-  ByteReader r(bytes, 0, "the test buffer is truncated");
+  ByteReader r(bytes, 0, InputError("the test buffer is truncated"));
   EXPECT_EQ(r.get<double>(), tiny);
   EXPECT_EQ(r.get<std::uint64_t>(), 0x0123456789ABCDEFull);
   EXPECT_EQ(r.get<float>(), 3.25f);

@@ -52,8 +52,8 @@ TEST(ModelFormat01, DetailsDecodeLittleEndianAsDocumented) {
   const std::vector<std::uint8_t> bytes = test::read_all(kCommitted / "details.bin");
   const ShapeModel m = load_model(kCommitted.string());
   ASSERT_EQ(std::string(bytes.begin(), bytes.begin() + 8), "MRSNKDET");
-  EXPECT_EQ(little_endian(bytes, 8, 4), 1u);                          // layout version
-  EXPECT_EQ(little_endian(bytes, 12, 4), 1u);                         // butterfly
+  EXPECT_EQ(little_endian(bytes, 8, 4), 1u);   // layout version
+  EXPECT_EQ(little_endian(bytes, 12, 4), 1u);  // butterfly
   const auto L = static_cast<std::size_t>(little_endian(bytes, 32, 4));
   const auto n0 = static_cast<std::size_t>(little_endian(bytes, 36, 4));
   const auto m0 = static_cast<std::size_t>(little_endian(bytes, 40, 4));
