@@ -5,8 +5,7 @@
 namespace mrsnake::cli {
 
 ExitCode exit_code_of(const Error& error) {
-  if (dynamic_cast<const InputError*>(&error) || dynamic_cast<const TopologyError*>(&error))
-    return ExitCode::bad_input;
+  if (dynamic_cast<const InputError*>(&error) || dynamic_cast<const TopologyError*>(&error)) return ExitCode::bad_input;
   if (dynamic_cast<const OutputError*>(&error)) return ExitCode::output;
   if (dynamic_cast<const AlgorithmError*>(&error)) return ExitCode::failed;
   if (dynamic_cast<const PartialFailure*>(&error)) return ExitCode::some_failed;

@@ -27,10 +27,8 @@ struct LloydOptions {
   double step = 1.0;      ///< fraction of the way to the centroid moved per iteration
   /// Density samples per iteration over all faces: a face gets about budget / faces of them
   /// (at least the 3 corner-quadrilateral centroids, from about 2.8k faces up). Coarse levels
-  /// integrate finely. At the fine levels the 3 samples per face were measured to be enough
-  /// (the density is interpolated linearly from the input's vertices): 25k against 400k on the
-  /// 5 bench/remesh meshes and the liver: RMS within 2 %, Q min within ±0.05 (either way),
-  /// 40-60 % less remeshing time (docs/bench-remesh.md).
+  /// integrate finely; at the fine levels 3 samples per face suffice, as the density is
+  /// interpolated linearly from the input's vertices (docs/remesh.md, "Tuning knobs").
   int sample_budget = 25000;
 };
 

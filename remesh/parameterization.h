@@ -45,11 +45,8 @@ enum class SphereMap {
 
 struct ParameterizationOptions {
   SphereMap sphere_map = SphereMap::automatic;
-  /// With automatic: the face count from which the two-halves map is used. On the 179k-face
-  /// liver its solve takes 0.55 s instead of 0.87 s; on the small benchmark meshes (4k-28k
-  /// faces) the whole remeshing takes about as long either way, and the punctured map's worst
-  /// triangles come out better on bear, blobby and retinal, worse on heart
-  /// (bench/bench_build_model.sh, bench/remesh).
+  /// With automatic: the face count from which the two-halves map is used (it solves faster on
+  /// large inputs; docs/remesh.md, "Tuning knobs").
   int halves_from_faces = 100000;
 };
 

@@ -64,8 +64,8 @@ struct AppearanceOptions {
   int half_length = 5;
   double shell_voxels = 3;  ///< statistics shell thickness, in voxels of the full-resolution image
   ProfileAlignment alignment = ProfileAlignment::automatic;
-  /// automatic: the largest step residual of profiles still taken for a clean step. Measured
-  /// residuals: synthetic blobs 0.06–0.13, the synthetic hearts 0.32–0.38, real CT and MRI ≥ 0.56.
+  /// automatic: the largest step residual of profiles still taken for a clean step (between
+  /// the residuals of synthetic phantoms and of real images; docs/snake.md).
   double clean_edge_max_residual = 0.5;
   /// edges: the largest shift of a profile's centre, in voxel steps of the full-resolution
   /// image along the vertex normal (the largest axis step projected on it: a label's rounding
@@ -114,9 +114,6 @@ void to_json(nlohmann::json& j, const ProfileAlignmentReport& r);
 /// image's noise averages out) against the ideal step (region.inside before the surface,
 /// region.outside after it, their mean on it), as an RMS difference over the contrast
 /// |inside − outside|; the result is the largest, over the levels, of its 90th percentile.
-/// Measured: blobs on a flat background 0.06–0.13 (mrsnake synth, SNR 8 and 4 references),
-/// a noisy sphere 0.07 and the same sphere in a shell 0.28 (the unit test), the synthetic
-/// heart inside its wall 0.38, real CT and MRI 0.56 and more.
 /// \return +infinity if there is no contrast, or faces do not match the levels.
 double profile_step_residual(const Appearance& appearance, const std::vector<RowMatrixX3i>& faces);
 

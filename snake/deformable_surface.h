@@ -15,8 +15,8 @@
 ///                 model's tangential umbrella, scaled by ℓ_v/ℓ̂_v and turned into the current
 ///                 tangent plane by the rotation that best maps the model's ring directions
 ///                 onto the current ones; zero at the model's shape in any pose, so that the
-///                 wavelet details land where the model put them. A plain uniform pull here
-///                 deformed coarse meshes: Dice 0.97 → 0.84 on the CT liver without any image force)
+///                 wavelet details land where the model put them; a plain uniform pull
+///                 would deform the coarse meshes, docs/snake.md)
 ///  - external     w_e·o_v·n_v, o_v the matched offset along the normal, averaged over the
 ///                 1-ring to resist noise
 /// Each step x ← x + τ·F is capped to max_step_fraction·ℓ_v and to |o_v| + that cap along

@@ -44,20 +44,15 @@ double default_marching_cubes_spacing(const StructureScale& scale);
 /// The default finest face count: equilateral triangles whose edge is half the surface's
 /// sampling length (`sampling_mm`: the marching-cubes spacing, or the finest voxel) covering
 /// the area of `surface`, clamped to [min_faces, max_faces]. The levels finer than the image
-/// are synthesized rather than deformed, and give the rasterization its sub-voxel shape.
-/// (Across the mice, edges of half a voxel rather than one raised the two globus pallidi,
-/// 1.7 mm³, from Dice 0.870 and 0.885 to 0.873 and 0.887, and changed the other structures
-/// by at most 0.001; the cap keeps a large organ's model within the snake's budget.)
+/// are synthesized rather than deformed, and give the rasterization its sub-voxel shape; the
+/// cap keeps a large organ's model within the snake's budget (docs/initialization.md).
 /// \pre sampling_mm > 0 (otherwise max_faces).
 /// \throw nothing.
 int default_face_count(const TriMesh& surface, double sampling_mm, int min_faces = 1024, int max_faces = 32768);
 
 /// Margin, per side, of the reference image crop that segment registers: this many
-/// equivalent radii, so that the crop holds the structure's surroundings whatever its size.
-/// (Across the mice 6 rather than 4 raised the globus pallidi from Dice 0.873 and 0.887 to
-/// 0.880 and 0.891 and moved the larger structures by at most 0.0015; on the warped
-/// same-subject cases the mean rose by 0.0006. Smaller crops, 1.5-3 radii, lost some cases
-/// altogether.)
+/// equivalent radii, so that the crop holds the structure's surroundings whatever its size
+/// (docs/initialization.md gives the measurement).
 constexpr double kReferenceMarginRadii = 6.0;
 
 /// The default reference-crop margin per side: kReferenceMarginRadii equivalent radii (mm).
