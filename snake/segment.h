@@ -205,6 +205,8 @@ struct SegmentResult {
 /// \pre edge_voxels > 0 (otherwise the averaging is left as in options.snake).
 /// \throw nothing.
 SnakeOptions fine_level_snake_options(const SegmentOptions& options, double edge_voxels);
+/// The same from the level's snake options and the fine levels' settings.
+SnakeOptions fine_level_snake_options(const SnakeOptions& snake, const FineLevelOptions& fine, double edge_voxels);
 
 /// Segments `image` (any spacing and direction; not modified) with the model.
 /// \throw InputError if the model has no levels or its appearance does not match it, or if
