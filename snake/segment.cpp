@@ -60,6 +60,26 @@ std::string to_string(ForceMode mode) {
   return "?";
 }
 
+void to_json(nlohmann::json& j, const MomentsOptions& o) {
+  j = {{"roi_margin", o.roi_margin},
+       {"rotate", o.rotate},
+       {"min_axis_separation", o.min_axis_separation},
+       {"max_rotation_deg", o.max_rotation_deg},
+       {"threshold", std::isnan(o.threshold) ? nlohmann::json() : nlohmann::json(o.threshold)},
+       {"bright_object", o.bright_object}};
+}
+
+void from_json(const nlohmann::json& j, MomentsOptions& o) {
+  const MomentsOptions d;
+  o.roi_margin = j.value("roi_margin", d.roi_margin);
+  o.rotate = j.value("rotate", d.rotate);
+  o.min_axis_separation = j.value("min_axis_separation", d.min_axis_separation);
+  o.max_rotation_deg = j.value("max_rotation_deg", d.max_rotation_deg);
+  const auto threshold = j.find("threshold");
+  o.threshold = threshold == j.end() || threshold->is_null() ? d.threshold : threshold->get<double>();
+  o.bright_object = j.value("bright_object", d.bright_object);
+}
+
 SnakeOptions fine_level_snake_options(const SnakeOptions& snake, const FineLevelOptions& fine, double edge_voxels) {
   SnakeOptions o = snake;
   // k passes of the 7-point average on a regular mesh of edge e: a variance of k·(3/7)·e².
