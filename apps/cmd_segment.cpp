@@ -1,16 +1,8 @@
 // mrsnake segment: the multiresolution snake on a new volume (see snake/segment.h).
-#include <poll.h>
-#include <sys/prctl.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -20,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "apps/batch_pool.h"
 #include "apps/cli.h"
 #include "apps/exit_codes.h"
 #include "apps/hints.h"
@@ -28,6 +21,7 @@
 #include "mesh/distance.h"
 #include "mesh/errors.h"
 #include "mesh/image_io.h"
+#include "mesh/json_options.h"
 #include "mesh/json_text.h"
 #include "mesh/marching_cubes.h"
 #include "mesh/mesh_io.h"
@@ -99,6 +93,32 @@ void flag_doubtful_result(nlohmann::json& rep, const SnakeModel& model) {
   rep["reason"] = reason;
 }
 
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// The labels of `surface` on the image's grid (1 inside), and the seconds they took.
+void rasterize_timed(const TriMesh& surface, const Volume& image, Volume& labels, double& seconds) {
+  const auto t = std::chrono::steady_clock::now();
+  labels = rasterize_mesh(surface, image, 1.0f);
+  seconds = seconds_since(t);
+}
+
+// The self-intersections of `surface`, and the seconds their count took.
+void count_self_intersections_timed(const TriMesh& surface, int& count, double& seconds) {
+  const auto t = std::chrono::steady_clock::now();
+  count = count_self_intersections(surface);
+  seconds = seconds_since(t);
+}
+
+// surface.vtp, levels/level_j.vtp and report.json into `dir`.
+void write_meshes(const std::filesystem::path& dir, const SegmentResult& result, const nlohmann::json& rep) {
+  write_mesh((dir / "surface.vtp").string(), result.surface);
+  for (const LevelOutcome& l : result.levels)
+    write_mesh((dir / "levels" / ("level_" + std::to_string(l.level) + ".vtp")).string(), l.surface);
+  write_text_file_atomically((dir / "report.json").string(), json_text(rep, 2) + "\n");
+}
+
 // One image to segment, and where.
 struct SegmentCase {
   std::string image, truth, output;
@@ -148,16 +168,8 @@ SegmentCaseOutcome segment_case(const SegmentCase& c, const SnakeModel& model, c
   Volume labels;
   double rasterize_seconds = 0, count_seconds = 0;
   run_both_in_parallel(
-      [&] {
-        const auto t = std::chrono::steady_clock::now();
-        labels = rasterize_mesh(result.surface, image, 1.0f);
-        rasterize_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-      },
-      [&] {
-        const auto t = std::chrono::steady_clock::now();
-        result.self_intersections = count_self_intersections(result.surface);
-        count_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-      });
+      [&] { rasterize_timed(result.surface, image, labels, rasterize_seconds); },
+      [&] { count_self_intersections_timed(result.surface, result.self_intersections, count_seconds); });
   result.stage_seconds.emplace_back("self_intersections", count_seconds);
 
   nlohmann::json& rep = outcome.report;
@@ -165,6 +177,7 @@ SegmentCaseOutcome segment_case(const SegmentCase& c, const SnakeModel& model, c
   rep["image"] = c.image;
   rep["model"] = model_path;
   rep["init"] = to_string(options.init);
+  rep["options"] = options;  // as given (the count of self-intersections included): what --config reads
   rep["stage_seconds"]["load"] = load_seconds;
   rep["stage_seconds"]["rasterize"] = rasterize_seconds;
   // What a screening study compares: the organ's volume, as labels.nii.gz holds it.
@@ -185,14 +198,9 @@ SegmentCaseOutcome segment_case(const SegmentCase& c, const SnakeModel& model, c
   AtomicDirectory out(c.output, earlier);
   const std::filesystem::path dir = out.temp_path();
   std::filesystem::create_directories(dir / "levels");
-  const auto write_meshes = [&] {
-    write_mesh((dir / "surface.vtp").string(), result.surface);
-    for (const LevelOutcome& l : result.levels)
-      write_mesh((dir / "levels" / ("level_" + std::to_string(l.level) + ".vtp")).string(), l.surface);
-    write_text_file_atomically((dir / "report.json").string(), json_text(rep, 2) + "\n");
-  };
   // The compressed labels are written on the other core, beside the meshes.
-  run_both_in_parallel(write_meshes, [&] { write_volume((dir / "labels.nii.gz").string(), labels, VoxelType::uint8); });
+  run_both_in_parallel([&] { write_meshes(dir, result, rep); },
+                       [&] { write_volume((dir / "labels.nii.gz").string(), labels, VoxelType::uint8); });
   // After the join: the page's render forks a child, which must not start while another
   // thread may hold a lock (the allocator's, the loader's) that the child would then wait on.
   write_segment_page(dir / "report.html", c.image, image, c.truth.empty() ? nullptr : &truth, c.truth_label, result,
@@ -203,29 +211,40 @@ SegmentCaseOutcome segment_case(const SegmentCase& c, const SnakeModel& model, c
 }
 
 // The options segment and segment-batch share, and the SegmentOptions they give.
+// With --config, the file's options, and of the flags only those given.
 struct SnakeArgs {
-  std::string init = "auto", force = "auto", register_metric = "mattes";
+  std::string config, init = "auto", force = "auto", register_metric = "mattes";
   int max_iterations = -1;
+  const CLI::Option *init_flag = nullptr, *force_flag = nullptr, *metric_flag = nullptr;
 
   void add_to(CLI::App* cmd) {
-    cmd->add_option("--init", init,
-                    "Initial pose: auto (register+fit if the model has a reference image, else moments+fit), pose, "
-                    "moments, fit, moments+fit, register, register+fit")
-        ->capture_default_str();
-    cmd->add_option("--register-metric", register_metric,
-                    "Metric of --init register: mattes (mutual information) or mean_squares (normalized intensities)")
-        ->capture_default_str();
-    cmd->add_option("--force", force,
-                    "External force: auto (profiles if the model has an appearance, unless they learned a clean step), "
-                    "profile, edge")
-        ->capture_default_str();
+    cmd->add_option("--config", config,
+                    "Segmentation options, a JSON file (docs/segmentation.md; report.json's \"options\" is one); "
+                    "the flags given replace its values");
+    init_flag =
+        cmd->add_option("--init", init,
+                        "Initial pose: auto (register+fit if the model has a reference image, else moments+fit), pose, "
+                        "moments, fit, moments+fit, register, register+fit")
+            ->capture_default_str();
+    metric_flag =
+        cmd->add_option(
+               "--register-metric", register_metric,
+               "Metric of --init register: mattes (mutual information) or mean_squares (normalized intensities)")
+            ->capture_default_str();
+    force_flag =
+        cmd->add_option(
+               "--force", force,
+               "External force: auto (profiles if the model has an appearance, unless they learned a clean step), "
+               "profile, edge")
+            ->capture_default_str();
     cmd->add_option("--max-iterations", max_iterations, "Iterations per level at most (default 40)");
   }
   SegmentOptions options() const {
-    SegmentOptions o;
-    o.init = parse_init_mode(init);
-    o.registration.itk.metric = parse_registration_metric(register_metric);
-    o.force = parse_force_mode(force);
+    SegmentOptions o = config.empty() ? SegmentOptions{} : read_options_file<SegmentOptions>(config);
+    if (config.empty() || init_flag->count() > 0) o.init = parse_init_mode(init);
+    if (config.empty() || metric_flag->count() > 0)
+      o.registration.itk.metric = parse_registration_metric(register_metric);
+    if (config.empty() || force_flag->count() > 0) o.force = parse_force_mode(force);
     if (max_iterations >= 0) o.snake.max_iterations = max_iterations;
     return o;
   }
@@ -457,114 +476,6 @@ nlohmann::json batch_row(const std::string& image, const std::string& output, co
   return row;
 }
 
-// Runs batch_row on every image in `jobs` worker processes (forked after the model is read;
-// each takes every jobs-th image), calling `done(index, row)` in this process as rows come
-// in. Processes and not threads: a segmentation forks to render its page, which a second
-// thread holding a lock would deadlock, and ITK's thread settings are global.
-// \pre jobs >= 2; this process runs no other thread.
-void run_batch_in_processes(int jobs, const std::vector<std::string>& images, const std::vector<std::string>& outputs,
-                            const SnakeModel& model, const std::string& model_path, const SegmentOptions& options,
-                            const std::function<void(std::size_t, nlohmann::json)>& done) {
-  struct Worker {
-    pid_t pid = -1;
-    int fd = -1;
-    std::string pending;
-  };
-  std::vector<Worker> workers;
-  std::vector<bool> reported(images.size(), false);
-  std::fflush(stdout);
-  std::fflush(stderr);
-  for (int w = 0; w < jobs && static_cast<std::size_t>(w) < images.size(); ++w) {
-    int fds[2];
-    if (pipe(fds) != 0) throw Error(std::string("cannot start a batch worker: pipe failed: ") + std::strerror(errno));
-    const pid_t batch = getpid();
-    const pid_t pid = fork();
-    if (pid < 0) throw Error(std::string("cannot start a batch worker: fork failed: ") + std::strerror(errno));
-    if (pid == 0) {
-      // Nothing leaves this branch: the worker ends with _exit, without the atexit handlers or
-      // static destructors of the batch's state.
-      try {
-        close(fds[0]);
-        for (const Worker& other : workers) close(other.fd);
-        // Killed with the batch (its handler removes the temporaries), also if the batch died
-        // before this line.
-        prctl(PR_SET_PDEATHSIG, SIGTERM);
-        if (getppid() != batch) _exit(1);
-        for (std::size_t i = static_cast<std::size_t>(w); i < images.size(); i += static_cast<std::size_t>(jobs)) {
-          const std::string line =
-              json_text({{"index", i}, {"row", batch_row(images[i], outputs[i], model, model_path, options, {})}}) +
-              "\n";
-          for (std::size_t sent = 0; sent < line.size();) {
-            const ssize_t n = write(fds[1], line.data() + sent, line.size() - sent);
-            if (n < 0 && errno == EINTR) continue;
-            if (n <= 0) _exit(1);
-            sent += static_cast<std::size_t>(n);
-          }
-        }
-        close(fds[1]);
-      } catch (...) {
-        _exit(1);
-      }
-      _exit(0);
-    }
-    close(fds[1]);
-    workers.push_back({pid, fds[0], {}});
-  }
-  std::size_t open_pipes = workers.size();
-  while (open_pipes > 0) {
-    std::vector<pollfd> polled;
-    for (const Worker& worker : workers)
-      if (worker.fd >= 0) polled.push_back({worker.fd, POLLIN, 0});
-    if (poll(polled.data(), polled.size(), -1) < 0) {
-      if (errno == EINTR) continue;
-      throw Error(std::string("batch workers: poll failed: ") + std::strerror(errno));
-    }
-    for (Worker& worker : workers) {
-      if (worker.fd < 0) continue;
-      const auto it = std::find_if(polled.begin(), polled.end(), [&](const pollfd& p) { return p.fd == worker.fd; });
-      if (it == polled.end() || it->revents == 0) continue;
-      char buffer[65536];
-      const ssize_t n = read(worker.fd, buffer, sizeof buffer);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) {
-        close(worker.fd);
-        worker.fd = -1;
-        --open_pipes;
-        continue;
-      }
-      worker.pending.append(buffer, static_cast<std::size_t>(n));
-      for (std::size_t end; (end = worker.pending.find('\n')) != std::string::npos;) {
-        const nlohmann::json message = nlohmann::json::parse(worker.pending.substr(0, end));
-        worker.pending.erase(0, end + 1);
-        const auto index = message["index"].get<std::size_t>();
-        reported[index] = true;
-        // The paths as given: the line's JSON text replaced any bytes that are not UTF-8.
-        nlohmann::json row = message["row"];
-        row["image"] = images[index];
-        row["output"] = outputs[index];
-        done(index, std::move(row));
-      }
-    }
-  }
-  // A worker that died (a crash, a kill) leaves its remaining images unreported.
-  for (std::size_t w = 0; w < workers.size(); ++w) {
-    int status = 0;
-    while (waitpid(workers[w].pid, &status, 0) < 0 && errno == EINTR) {
-    }
-    for (std::size_t i = w; i < images.size(); i += workers.size())
-      if (!reported[i])
-        done(i, {{"image", images[i]},
-                 {"output", outputs[i]},
-                 {"status", "failed"},
-                 {"error", "its batch worker stopped (" +
-                               (WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status))
-                                                    : "exit code " + std::to_string(WEXITSTATUS(status))) +
-                               ") before segmenting it"},
-                 {"exit_code", static_cast<int>(ExitCode::internal)},
-                 {"wall_seconds", 0.0}});
-  }
-}
-
 }  // namespace
 
 void add_segment_batch_command(CLI::App& app) {
@@ -647,7 +558,8 @@ void add_segment_batch_command(CLI::App& app) {
       write_text_file_atomically((dir / "batch.csv").string(), batch_csv(summary["cases"]));
     };
     if (a->jobs > 1 && images.size() > 1) {
-      run_batch_in_processes(a->jobs, images, outputs, model, a->model, options, done);
+      const auto row = [&](std::size_t i) { return batch_row(images[i], outputs[i], model, a->model, options, {}); };
+      run_batch_in_processes(a->jobs, images, outputs, row, done);
     } else {
       for (std::size_t i = 0; i < images.size(); ++i)
         done(i, batch_row(images[i], outputs[i], model, a->model, options, terminal_progress()));

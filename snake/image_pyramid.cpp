@@ -109,4 +109,31 @@ std::vector<Volume> build_pyramid(const Volume& volume, int levels, std::size_t 
   return pyramid;
 }
 
+NormalizedPyramid::NormalizedPyramid(const Volume& image, const IntensityWindow& w) : window(w) {
+  level0_scale = 1.0 / (window.high - window.low);
+  level0_offset = -window.low * level0_scale;
+  owned_.reserve(8);
+  levels.push_back(&image);
+  while (levels.size() < 8) {
+    bool ok = true;
+    for (int a = 0; a < 3; ++a)
+      if (levels.back()->size[a] > 1 && (levels.back()->size[a] + 1) / 2 < 16) ok = false;
+    if (!ok) break;
+    owned_.push_back(downsample_by_two(*levels.back()));
+    if (levels.size() == 1) apply_intensity_window(owned_.back(), window);
+    levels.push_back(&owned_.back());
+  }
+  if (levels.size() == 1) {  // a tiny image: normalize a copy
+    owned_.push_back(image);
+    apply_intensity_window(owned_.back(), window);
+    levels[0] = &owned_.back();
+  }
+  level0_raw = levels[0] == &image;
+  for (const Volume* v : levels) spacings.push_back(v->max_spacing());
+  samplers.reserve(levels.size());
+  for (std::size_t k = 0; k < levels.size(); ++k)
+    samplers.emplace_back(*levels[k], k == 0 && level0_raw ? level0_scale : 1.0,
+                          k == 0 && level0_raw ? level0_offset : 0.0);
+}
+
 }  // namespace mrsnake

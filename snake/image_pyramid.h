@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "mesh/volume.h"
+#include "snake/sampler.h"
 
 namespace mrsnake {
 
@@ -40,5 +41,27 @@ Volume downsample_by_two(const Volume& volume);
 /// when an axis would drop below min_size voxels.
 /// \pre levels >= 1.
 std::vector<Volume> build_pyramid(const Volume& volume, int levels, std::size_t min_size = 16);
+
+/// The segmentation's image side: the pyramid of an image normalized by `window`, at most 8
+/// levels, each axis halved while it keeps at least 16 voxels. The full-resolution image is
+/// not copied: its sampler normalizes on the fly, and only the (8× smaller and below) levels
+/// are stored normalized; a tiny image (no level 1) is normalized in a copy.
+/// Holds pointers to `image`, which must outlive it; neither copied nor moved.
+class NormalizedPyramid {
+ public:
+  NormalizedPyramid(const Volume& image, const IntensityWindow& window);
+  NormalizedPyramid(const NormalizedPyramid&) = delete;
+  NormalizedPyramid& operator=(const NormalizedPyramid&) = delete;
+
+  IntensityWindow window;
+  double level0_scale = 1.0, level0_offset = 0.0;  ///< the normalization of the full-resolution image
+  std::vector<const Volume*> levels;               ///< levels[0]: the image itself when level0_raw
+  bool level0_raw = false;                         ///< levels[0] holds raw intensities (sampled normalized)
+  std::vector<double> spacings;                    ///< max_spacing of each level
+  std::vector<VolumeSampler> samplers;             ///< normalized samples of each level
+
+ private:
+  std::vector<Volume> owned_;  // levels 1.. (level 0 too when the image is too small for a pyramid)
+};
 
 }  // namespace mrsnake

@@ -205,6 +205,48 @@ struct SegmentResult {
 /// \pre edge_voxels > 0 (otherwise the averaging is left as in options.snake).
 /// \throw nothing.
 SnakeOptions fine_level_snake_options(const SegmentOptions& options, double edge_voxels);
+/// The same from the level's snake options and the fine levels' settings.
+SnakeOptions fine_level_snake_options(const SnakeOptions& snake, const FineLevelOptions& fine, double edge_voxels);
+
+// SegmentOptions as JSON (mesh/json_options.h: `segment --config FILE`, report.json's
+// "options"); docs/segmentation.md lists every key. Enums are their command-line names
+// (--init, --force, --register-metric); a name that is none of them is an InputError.
+// Left out, because the segmentation sets them itself: TargetFitOptions::tolerance_mm (from
+// fit_tolerance_voxels), RegistrationOptions::initial_translation and
+// ::moving_intensity_scale/offset (from the start and the image's normalization).
+inline void to_json(nlohmann::json& j, InitMode m) { j = to_string(m); }
+inline void from_json(const nlohmann::json& j, InitMode& m) { m = parse_init_mode(j.get<std::string>()); }
+inline void to_json(nlohmann::json& j, ForceMode m) { j = to_string(m); }
+inline void from_json(const nlohmann::json& j, ForceMode& m) { m = parse_force_mode(j.get<std::string>()); }
+inline void to_json(nlohmann::json& j, RegistrationMetric m) { j = to_string(m); }
+inline void from_json(const nlohmann::json& j, RegistrationMetric& m) {
+  m = parse_registration_metric(j.get<std::string>());
+}
+// MomentsOptions::threshold's NaN (Otsu's threshold) is null.
+void to_json(nlohmann::json& j, const MomentsOptions& o);
+void from_json(const nlohmann::json& j, MomentsOptions& o);
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SnakeOptions, membrane_weight, thin_plate_weight, prior_weight,
+                                                tangential_weight, external_weight, time_step, max_step_fraction,
+                                                offset_median, offset_smoothing, max_iterations, min_iterations,
+                                                tolerance, patience)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(TargetFitOptions, iterations, with_scale, trim_fraction, patience)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RegistrationOptions, metric, histogram_bins, shrink_factors,
+                                                smoothing_voxels, samples_per_level, iterations_per_level,
+                                                evaluation_samples, initial_step_voxels, rotation_radius_mm,
+                                                step_factor_per_level, min_step_voxels, relaxation, min_relative_change,
+                                                convergence_window, moving_margin_fraction, moving_margin_voxels,
+                                                max_seconds, threads)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ReferenceRegistrationOptions, itk, min_scale, max_scale)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FineLevelOptions, deform_edge_centred, min_edge_voxels,
+                                                offset_smoothing_voxels, min_iterations, patience,
+                                                profile_step_fraction)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(
+    SegmentOptions, snake, init, registration, force, clean_step_max_residual, fit, fit_tolerance_voxels,
+    fit_patience_after_registration, fit_level, moments, range_edge_fraction, coarse_range_edge_fraction,
+    min_range_voxels, fit_min_range_voxels, step_voxels, profile_step_fraction, max_range_voxels, window_voxels,
+    edge_per_voxel, max_edge_cost, max_profile_cost, profile_distance_penalty, edge_distance_penalty, search_min_gain,
+    cost_ring_weight, cost_ring_full_weight_cost, intensity_samples, count_self_intersections, undo_self_intersections,
+    min_edge_voxels, fine)
 
 /// Segments `image` (any spacing and direction; not modified) with the model.
 /// \throw InputError if the model has no levels or its appearance does not match it, or if
