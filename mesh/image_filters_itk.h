@@ -1,8 +1,8 @@
 #pragma once
 /// \file image_filters_itk.h
-/// ITK image filters behind plain `Volume`s. The implementation is the only translation unit
-/// of the snake module that sees ITK (which bundles its own Eigen), so this header exposes
-/// nothing but mesh/volume.h and std types.
+/// ITK image filters behind plain `Volume`s. The implementation is part of mesh_itk, the mesh
+/// module's ITK side (ITK bundles its own Eigen), so this header exposes nothing but
+/// mesh/volume.h and std types.
 #include <array>
 
 #include "mesh/volume.h"
