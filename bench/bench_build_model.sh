@@ -28,7 +28,7 @@ wall, kb, user, system = open(sys.argv[2]).read().split()
 q = json.load(open(sys.argv[3]))
 d, d20 = q["distance"], json.load(open(sys.argv[4]))["distance"]
 print(f"build-model liver-labels.nii.gz label 255: {s['faces']} faces, {s['levels']} levels, "
-      f"input surface {s['input_faces']} faces (--mc-spacing {s.get('mc_spacing_mm', 0)} mm)")
+      f"input surface {s['input_faces']} faces (marching-cubes spacing {s.get('mc_spacing_mm', 0)} mm)")
 print(f"{'stage':<20}{'seconds':>10}")
 for t in s['timings']:
     print(f"{t['stage']:<20}{t['seconds']:>10.3f}")
