@@ -45,10 +45,10 @@ void add_build_model_command(CLI::App& app);
 void add_segment_command(CLI::App& app);
 void add_segment_batch_command(CLI::App& app);
 
-/// Adds --sphere-map auto|halves|punctured (remesh and build-model), bound to `map`.
+/// Adds --sphere-map auto|halves|punctured (remesh), bound to `map`.
 void add_sphere_map_option(CLI::App& command, SphereMap& map);
 
-/// Adds --fit-rounds N (remesh and build-model), bound to `rounds` (RemeshOptions::fit.rounds);
+/// Adds --fit-rounds N (remesh), bound to `rounds` (RemeshOptions::fit.rounds);
 /// its current value is the default the help shows.
 void add_fit_rounds_option(CLI::App& command, int& rounds);
 

@@ -37,7 +37,7 @@ void add_mc_command(CLI::App& app) {
       ->check(CLI::Range(0, 1000));
   cmd->add_option("--spacing", a->spacing,
                   "Extract the 0.5 isosurface of the label's Gaussian-smoothed occupancy resampled to this isotropic "
-                  "spacing in mm (as 'mrsnake build-model --mc-spacing'); 0 = the voxels' own surface (default)")
+                  "spacing in mm (as build-model's surface.mc_spacing_mm); 0 = the voxels' own surface (default)")
       ->check(CLI::Range(0.0, 100.0));
   cmd->add_flag("--json", a->json, "Print a JSON summary");
   cmd->footer(

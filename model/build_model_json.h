@@ -1,7 +1,7 @@
 #pragma once
 /// \file build_model_json.h
 /// BuildModelOptions as JSON: the form of `mrsnake build-model --config FILE` and of the
-/// "options" key of model.json, so that a model can be built again exactly. Keys are the
+/// "build_options" key of model.json, so that a model can be built again exactly. Keys are the
 /// field names, nested as the structs; a missing key keeps the preset's value. Read with
 /// options_from_json / read_options_file (mesh/json_options.h), which refuse unknown keys.
 #include <nlohmann/json.hpp>
