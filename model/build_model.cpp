@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -197,8 +198,10 @@ BuiltModel build_model(const Volume& labels_in, const Volume* image, const Build
   validate(options);
   StageClock clock;
   BuiltModel built;
-  const Volume labels =
-      options.component > 0 ? keep_label_part(labels_in, options.label, options.component) : labels_in;
+  // Only a chosen part is a new volume; the whole label is used in place, not copied.
+  std::optional<Volume> part;
+  if (options.component > 0) part = keep_label_part(labels_in, options.label, options.component);
+  const Volume& labels = part ? *part : labels_in;
   built.scale = measure_structure(labels, options.label);
   extract_surface(labels, options, progress, built);
   clock.lap("marching_cubes");
