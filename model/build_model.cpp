@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mesh/label_repair.h"
+#include "mesh/stage_clock.h"
 #include "mesh/quality.h"
 #include "model/build_model_json.h"
 #include "model/snake_adapter.h"
@@ -26,21 +27,6 @@ RemeshOptions model_remesh_preset() {
 }
 
 namespace {
-
-// Seconds per stage, in order.
-class StageClock {
- public:
-  void lap(const std::string& stage) {
-    const auto now = std::chrono::steady_clock::now();
-    laps_.emplace_back(stage, std::chrono::duration<double>(now - start_).count());
-    start_ = now;
-  }
-  std::vector<std::pair<std::string, double>>& laps() { return laps_; }
-
- private:
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
-  std::vector<std::pair<std::string, double>> laps_;
-};
 
 // The label's surface, with the spacing and smoothing it was extracted with.
 void extract_surface(const Volume& labels, const BuildModelOptions& options, const ProgressFn& progress,
@@ -77,10 +63,10 @@ void remesh_surface(const BuildModelOptions& options, const ProgressFn& progress
   ro.compute_stats = options.report.level_stats;
   ro.progress = progress;
   built.hierarchy = remesh(built.surface.mesh, ro);
-  clock.lap("remesh");
+  clock.end("remesh");
   double levels_seconds = 0;
   for (const RemeshLevel& level : built.hierarchy.levels) levels_seconds += level.seconds;
-  auto& laps = clock.laps();
+  auto& laps = built.timings;
   const double remesh_seconds = laps.back().second;
   laps.pop_back();
   laps.emplace_back("parameterization", std::max(0.0, remesh_seconds - levels_seconds));
@@ -196,33 +182,32 @@ std::string describe_poor_fit(const LabelFit& fit) {
 BuiltModel build_model(const Volume& labels_in, const Volume* image, const BuildModelOptions& options,
                        const ProgressFn& progress) {
   validate(options);
-  StageClock clock;
   BuiltModel built;
+  StageClock clock(built.timings);
   // Only a chosen part is a new volume; the whole label is used in place, not copied.
   std::optional<Volume> part;
   if (options.component > 0) part = keep_label_part(labels_in, options.label, options.component);
   const Volume& labels = part ? *part : labels_in;
   built.scale = measure_structure(labels, options.label);
   extract_surface(labels, options, progress, built);
-  clock.lap("marching_cubes");
+  clock.end("marching_cubes");
 
   remesh_surface(options, progress, built, clock);
 
   report(progress, "wavelet analysis", 0.0);
   built.model = make_model(built.hierarchy.connectivity, built.hierarchy.levels.back().positions, options.wavelet);
   report(progress, "wavelet analysis", 1.0);
-  clock.lap("analysis");
+  clock.end("analysis");
 
   check_fit(labels, options, built);
-  clock.lap("label_fit");
+  clock.end("label_fit");
 
   if (image != nullptr) {
     add_image_sections(*image, options, progress, built);
-    clock.lap("appearance");
+    clock.end("appearance");
   }
   record_provenance(labels, options, built);
   if (options.report.compare_unrelaxed) built.unrelaxed = remesh_unrelaxed(built);
-  built.timings = clock.laps();
   built.model.timings = built.timings;
   return built;
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "mesh/stage_clock.h"
 #include "mesh/distance.h"
 #include "mesh/errors.h"
 #include "snake/image_pyramid.h"
@@ -133,21 +134,6 @@ ForceChoice choose_force(const SnakeModel& model, ForceMode force, double clean_
                                                !(c.step_residual <= clean_step_max_residual));
   return c;
 }
-
-// The seconds of consecutive stages, each from the end of the one before.
-class StageClock {
- public:
-  explicit StageClock(std::vector<std::pair<std::string, double>>& stages) : stages_(stages) {}
-  void end(const std::string& name) {
-    stages_.emplace_back(name, seconds_since(start_));
-    restart();
-  }
-  void restart() { start_ = Clock::now(); }
-
- private:
-  std::vector<std::pair<std::string, double>>& stages_;
-  Clock::time_point start_ = Clock::now();
-};
 
 LevelSearchOptions level_search_options(const SegmentOptions& o) {
   LevelSearchOptions s;
