@@ -19,9 +19,13 @@ std::vector<Eigen::Vector2d> flatten_star(const Eigen::Vector3d& center, const s
     if (i + 1 < k) phi[i + 1] = total;
   }
   const double a = (closed ? 2 * M_PI : M_PI) / total;
+  // Radii relative to their mean before the power, so that the chart keeps the star's size
+  // and a sharp tip (a large a) does not underflow: a scaling does not change the shapes.
+  double mean_radius = 0;
+  for (const Eigen::Vector3d& r : ring) mean_radius += (r - center).norm() / k;
   std::vector<Eigen::Vector2d> flat(k);
   for (int i = 0; i < k; ++i) {
-    const double r = std::pow((ring[i] - center).norm(), a);
+    const double r = mean_radius * std::pow((ring[i] - center).norm() / mean_radius, a);
     flat[i] = r * Eigen::Vector2d(std::cos(a * phi[i]), std::sin(a * phi[i]));
   }
   return flat;
