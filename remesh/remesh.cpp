@@ -24,50 +24,19 @@
 #include "remesh/sizing.h"
 #include "remesh/surface_fit.h"
 #include "remesh/remesh_options_json.h"
+#include "remesh/remesh_stages.h"
 #include "remesh/triangle_repair.h"
 #include "mesh/topology.h"
 
 namespace mrsnake {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-/// Points measured per surface for the per-level distance statistics.
-constexpr long long kMaxStatsSamples = 50000;
-
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-// Levels L and base size n0 so that F0·4^L is near the target, with F0 in [128, 512): a base
-// of ~65-260 vertices spread over the shape absorbs its curvature, and since about half of
-// them are irregular, they stay under 1% of the finest level's vertices.
-void choose_resolution(int target_faces, int& levels, int& n0) {
-  levels = 1;
-  double f0 = target_faces / 4.0;
-  while (f0 >= 512) {
-    f0 /= 4;
-    ++levels;
-  }
-  n0 = std::max(8, static_cast<int>(std::lround(f0 / 2 + 2)));
-}
-
-// Moves every row of X to its closest point on the locator's surface.
-void reproject_onto(const SurfaceLocator& surface, RowMatrixX3d& X) {
-  parallel_ranges(static_cast<std::size_t>(X.rows()), [&](std::size_t begin, std::size_t end) {
-    for (auto v = static_cast<Eigen::Index>(begin); v < static_cast<Eigen::Index>(end); ++v)
-      X.row(v) = surface.closest(X.row(v).transpose()).point.transpose();
-  });
-}
+using namespace remesh_stages;
 
 // Edge rings in about one base spacing: sqrt(input vertices / base vertices).
 int base_spacing_rings(const TriMesh& surface, int n0) {
   return static_cast<int>(std::lround(std::sqrt(surface.num_vertices() / static_cast<double>(n0))));
 }
-
-// The hierarchy's shape: L levels of 1:4 splits over a base of n0 vertices.
-struct Resolution {
-  int levels;
-  int base_vertices;
-};
 
 // The wanted 3D point densities: `wanted` for the levels' relaxation, `base_density` for the
 // base vertices' spread (both relative, >= 1 where nothing asks for more).
@@ -142,46 +111,6 @@ void check_options(const RemeshOptions& o) {
   if (o.base_vertices < 6) throw std::invalid_argument("base_vertices must be at least 6");
   if (!(o.sizing.density_exponent >= 0 && o.sizing.density_exponent <= 8))
     throw std::invalid_argument("sizing.density_exponent must be in [0, 8]");
-}
-
-// The levels L and the base size n0 asked for (the bend bound may still grow the base).
-Resolution initial_resolution(const RemeshOptions& options) {
-  Resolution r{options.levels, options.base_vertices};
-  if (r.levels == 0) choose_resolution(options.target_faces, r.levels, r.base_vertices);
-  return r;
-}
-
-// The input as it is parameterized: the original without unreferenced vertices, or a
-// simplification of it when it is much finer than the finest level (the parameterization is
-// the costly part).
-struct PreparedInput {
-  TriMesh original;
-  TriMesh work;
-  bool simplified = false;
-  nlohmann::json simplify_info;  ///< simplify_seconds, when a simplification was made
-};
-
-// \throw TopologyError if the input is neither a disk nor a closed genus-0 surface.
-PreparedInput prepare_input(const TriMesh& input, const SimplifyOptions& options, const Resolution& resolution,
-                            const ProgressFn& progress, Clock::time_point start) {
-  PreparedInput p;
-  p.original = remove_unreferenced_vertices(input);
-  const TopologyReport topology = topology_report(p.original);
-  require_disk_or_sphere(topology, "the input surface");
-  p.work = p.original;
-  const double finest_faces = 2.0 * resolution.base_vertices * std::pow(4.0, resolution.levels);
-  const double limit = std::max<double>(options.above_faces, 8 * finest_faces);
-  if (options.above_faces > 0 && p.original.num_faces() > limit) {
-    report(progress, "simplify", 0);
-    TriMesh simplified_mesh = simplify_to_faces(p.original, static_cast<int>(limit));
-    p.simplify_info["simplify_seconds"] = seconds_since(start);
-    const TopologyReport after = topology_report(simplified_mesh);
-    if (after.is_disk() == topology.is_disk() && after.is_closed_genus0() == topology.is_closed_genus0()) {
-      p.work = std::move(simplified_mesh);
-      p.simplified = true;
-    }
-  }
-  return p;
 }
 
 // The parameterization of the prepared input, and the original's closest-point tree (for the
@@ -407,23 +336,6 @@ nlohmann::json level_stats(int j, const RemeshLevel& level, const RowMatrixX3i& 
   return s;
 }
 
-// Quality and distance to the input, into the level's stats. Metro-style sampling of both
-// surfaces, then a uniform random subset of at most 50k points per surface: a marching-cubes
-// input has hundreds of thousands of faces, and 50k points estimate the RMS to well under 1 %
-// (the Hausdorff distance is the largest over the subset).
-void measure_level(const LevelContext& ctx, const RowMatrixX3i& F, RemeshLevel& level) {
-  nlohmann::json& s = level.stats;
-  const TriMesh mesh{level.positions, F};
-  s["quality"] = mesh_quality(mesh);
-  DistanceOptions sampling;
-  sampling.samples_per_face =
-      std::clamp(static_cast<int>(5e5 / std::max(ctx.original.num_faces(), mesh.num_faces())), 1, 10);
-  sampling.max_samples_per_mesh = kMaxStatsSamples;
-  s["distance"] = surface_distance(mesh, ctx.original, *ctx.locator, sampling);
-  s["distance"]["samples_per_face"] = sampling.samples_per_face;
-  s["distance"]["max_samples_per_mesh"] = sampling.max_samples_per_mesh;
-}
-
 // Level j: split (j > 0), relax in D and on the surface; with the full method, snap the tips
 // (finest level), repair, and fit (finest level); the projection onto the original input when a
 // simplification was parameterized. `extra_seconds` is added to the level's time.
@@ -462,7 +374,7 @@ RemeshLevel build_level(const LevelContext& ctx, const RemeshOptions& options, i
   level.flipped_triangles = flipped;
   level.seconds = seconds_since(start) + extra_seconds;
   level.stats = level_stats(j, level, F, r);
-  if (options.compute_stats) measure_level(ctx, F, level);
+  if (options.compute_stats) measure_level(ctx.original, *ctx.locator, F, level);
   return level;
 }
 

@@ -25,6 +25,37 @@ std::vector<Eigen::Vector2i> rim_neighbours(const std::vector<std::pair<int, int
 
 }  // namespace
 
+std::optional<Eigen::Vector3d> tangential_move(const RowMatrixX3d& X, const RowMatrixX3i& F, const VertexStars& stars,
+                                               int v, SmoothingTarget target, const Eigen::VectorXd& vertex_density) {
+  const std::optional<Eigen::Vector3d> normal = vertex_normal(X, F, stars, v);
+  if (!normal) return std::nullopt;
+  const Eigen::Vector3d x = X.row(v);
+  Eigen::Vector3d aim = Eigen::Vector3d::Zero();
+  double total = 0;
+  for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
+    const int f = stars.faces[i];
+    int k = 0;
+    while (F(f, k) != v) ++k;
+    const int ia = F(f, (k + 1) % 3), ib = F(f, (k + 2) % 3);
+    const Eigen::Vector3d a = X.row(ia), b = X.row(ib);
+    if (target == SmoothingTarget::equilateral_apexes) {
+      if (const auto apex = equilateral_apex(a, b, *normal)) {
+        aim += *apex;
+        total += 1;
+      }
+    } else {
+      const double rho = (vertex_density[v] + vertex_density[ia] + vertex_density[ib]) / 3.0;
+      const double weight = 0.5 * (a - x).cross(b - x).norm() * rho * rho;
+      aim += weight * (x + a + b) / 3.0;
+      total += weight;
+    }
+  }
+  if (!(total > 0)) return std::nullopt;
+  Eigen::Vector3d move = aim / total - x;
+  move -= move.dot(*normal) * *normal;
+  return move;
+}
+
 int smooth_shapes_in_domain(DomainKind kind, const RowMatrixX3i& F, const DomainMesh& param,
                             const RowMatrixX3d& surface_V, RowMatrixX3d& U, RowMatrixX3d& X, std::vector<int>& hints,
                             const ShapeSmoothingOptions& options) {
@@ -64,31 +95,9 @@ int smooth_shapes_in_domain(DomainKind kind, const RowMatrixX3i& F, const Domain
         const Eigen::Vector3d tangent = (b - a).normalized();
         move = (0.5 * (a + b) - x).dot(tangent) * tangent;
       } else {
-        const std::optional<Eigen::Vector3d> normal = vertex_normal(X, F, stars, v);
-        if (!normal) continue;
-        Eigen::Vector3d target = Eigen::Vector3d::Zero();
-        double total = 0;
-        for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
-          const int f = stars.faces[i];
-          int k = 0;
-          while (F(f, k) != v) ++k;
-          const int ia = F(f, (k + 1) % 3), ib = F(f, (k + 2) % 3);
-          const Eigen::Vector3d a = X.row(ia), b = X.row(ib);
-          if (options.target == SmoothingTarget::equilateral_apexes) {
-            if (const auto apex = equilateral_apex(a, b, *normal)) {
-              target += *apex;
-              total += 1;
-            }
-          } else {
-            const double rho = (vertex_density[v] + vertex_density[ia] + vertex_density[ib]) / 3.0;
-            const double weight = 0.5 * (a - x).cross(b - x).norm() * rho * rho;
-            target += weight * (x + a + b) / 3.0;
-            total += weight;
-          }
-        }
-        if (!(total > 0)) continue;
-        move = target / total - x;
-        move -= move.dot(*normal) * *normal;
+        const std::optional<Eigen::Vector3d> interior = tangential_move(X, F, stars, v, options.target, vertex_density);
+        if (!interior) continue;
+        move = *interior;
       }
       // Pull the 3D move back to D through the affine map of the input triangle under v.
       const std::optional<TrianglePullback> pullback = TrianglePullback::of(surface_V, PD, PF, hints[v]);

@@ -10,9 +10,11 @@
 /// relaxation), the tangential part of that 3D move is pulled back to D through the Jacobian of
 /// the input triangle under the vertex, and the vertex is re-lifted. Moves that would flip a
 /// triangle in D are halved until they do not.
+#include <optional>
 #include <vector>
 
 #include "mesh/trimesh.h"
+#include "mesh/vertex_stars.h"
 #include "remesh/domain.h"
 
 namespace mrsnake {
@@ -40,6 +42,13 @@ struct ShapeSmoothingOptions {
   /// worst triangles worse. 0 = no check.
   double quality_floor = 0;
 };
+
+/// The 3D move of vertex v of (X, F) toward `target`, in the tangent plane of its normal;
+/// nullopt where its normal or its target is undefined. `vertex_density` (one entry per vertex of
+/// X) weighs the area_centroid target.
+/// \pre `stars` are F's vertex stars.
+std::optional<Eigen::Vector3d> tangential_move(const RowMatrixX3d& X, const RowMatrixX3i& F, const VertexStars& stars,
+                                               int v, SmoothingTarget target, const Eigen::VectorXd& vertex_density);
 
 /// Smooths the domain positions U of (U, F) and updates their lifts X.
 /// \pre X = lift of U onto the surface whose domain mesh is `param` (3D positions surface_V);

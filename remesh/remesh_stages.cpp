@@ -1,0 +1,90 @@
+#include "remesh/remesh_stages.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "mesh/parallel.h"
+#include "mesh/quality.h"
+#include "mesh/topology.h"
+#include "remesh/simplify.h"
+
+namespace mrsnake::remesh_stages {
+
+/// Points measured per surface for the per-level distance statistics.
+constexpr long long kMaxStatsSamples = 50000;
+
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+// Levels L and base size n0 so that F0·4^L is near the target, with F0 in [128, 512): a base
+// of ~65-260 vertices spread over the shape absorbs its curvature, and since about half of
+// them are irregular, they stay under 1% of the finest level's vertices.
+void choose_resolution(int target_faces, int& levels, int& n0) {
+  levels = 1;
+  double f0 = target_faces / 4.0;
+  while (f0 >= 512) {
+    f0 /= 4;
+    ++levels;
+  }
+  n0 = std::max(8, static_cast<int>(std::lround(f0 / 2 + 2)));
+}
+
+// The levels L and the base size n0 asked for (the bend bound may still grow the base).
+Resolution initial_resolution(const RemeshOptions& options) {
+  Resolution r{options.levels, options.base_vertices};
+  if (r.levels == 0) choose_resolution(options.target_faces, r.levels, r.base_vertices);
+  return r;
+}
+
+// Moves every row of X to its closest point on the locator's surface.
+void reproject_onto(const SurfaceLocator& surface, RowMatrixX3d& X) {
+  parallel_ranges(static_cast<std::size_t>(X.rows()), [&](std::size_t begin, std::size_t end) {
+    for (auto v = static_cast<Eigen::Index>(begin); v < static_cast<Eigen::Index>(end); ++v)
+      X.row(v) = surface.closest(X.row(v).transpose()).point.transpose();
+  });
+}
+
+// The input as it is parameterized: the original without unreferenced vertices, or a
+// simplification of it when it is much finer than the finest level (the parameterization is
+// the costly part).
+
+// \throw TopologyError if the input is neither a disk nor a closed genus-0 surface.
+PreparedInput prepare_input(const TriMesh& input, const SimplifyOptions& options, const Resolution& resolution,
+                            const ProgressFn& progress, Clock::time_point start) {
+  PreparedInput p;
+  p.original = remove_unreferenced_vertices(input);
+  const TopologyReport topology = topology_report(p.original);
+  require_disk_or_sphere(topology, "the input surface");
+  p.work = p.original;
+  const double finest_faces = 2.0 * resolution.base_vertices * std::pow(4.0, resolution.levels);
+  const double limit = std::max<double>(options.above_faces, 8 * finest_faces);
+  if (options.above_faces > 0 && p.original.num_faces() > limit) {
+    report(progress, "simplify", 0);
+    TriMesh simplified_mesh = simplify_to_faces(p.original, static_cast<int>(limit));
+    p.simplify_info["simplify_seconds"] = seconds_since(start);
+    const TopologyReport after = topology_report(simplified_mesh);
+    if (after.is_disk() == topology.is_disk() && after.is_closed_genus0() == topology.is_closed_genus0()) {
+      p.work = std::move(simplified_mesh);
+      p.simplified = true;
+    }
+  }
+  return p;
+}
+
+// Quality and distance to the input, into the level's stats. Metro-style sampling of both
+// surfaces, then a uniform random subset of at most 50k points per surface: a marching-cubes
+// input has hundreds of thousands of faces, and 50k points estimate the RMS to well under 1 %
+// (the Hausdorff distance is the largest over the subset).
+void measure_level(const TriMesh& original, const SurfaceLocator& locator, const RowMatrixX3i& F, RemeshLevel& level) {
+  nlohmann::json& s = level.stats;
+  const TriMesh mesh{level.positions, F};
+  s["quality"] = mesh_quality(mesh);
+  DistanceOptions sampling;
+  sampling.samples_per_face =
+      std::clamp(static_cast<int>(5e5 / std::max(original.num_faces(), mesh.num_faces())), 1, 10);
+  sampling.max_samples_per_mesh = kMaxStatsSamples;
+  s["distance"] = surface_distance(mesh, original, locator, sampling);
+  s["distance"]["samples_per_face"] = sampling.samples_per_face;
+  s["distance"]["max_samples_per_mesh"] = sampling.max_samples_per_mesh;
+}
+
+}  // namespace mrsnake::remesh_stages

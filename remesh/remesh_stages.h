@@ -1,0 +1,52 @@
+#pragma once
+/// \file remesh_stages.h
+/// The stages that remesh() runs whatever its parameter domain (remesh/remesh.h): the choice of
+/// resolution, the preparation of the input, the reprojection onto it and the measures of a
+/// level. Internal to the remesh module.
+#include <chrono>
+
+#include <nlohmann/json.hpp>
+
+#include "mesh/distance.h"
+#include "mesh/progress.h"
+#include "mesh/trimesh.h"
+#include "remesh/remesh.h"
+
+namespace mrsnake::remesh_stages {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start);
+
+/// The hierarchy's shape: L levels of 1:4 splits over a base of n0 vertices.
+struct Resolution {
+  int levels;
+  int base_vertices;
+};
+
+/// Levels L and base size n0 so that F0·4^L is near target_faces, with F0 in [128, 512).
+void choose_resolution(int target_faces, int& levels, int& n0);
+
+/// The levels L and the base size n0 that the options ask for.
+Resolution initial_resolution(const RemeshOptions& options);
+
+/// The input as it is parameterized: the original without unreferenced vertices, or a
+/// simplification of it when it is much finer than the finest level.
+struct PreparedInput {
+  TriMesh original;
+  TriMesh work;
+  bool simplified = false;
+  nlohmann::json simplify_info;  ///< simplify_seconds, when a simplification was made
+};
+
+/// \throw TopologyError if the input is neither a disk nor a closed genus-0 surface.
+PreparedInput prepare_input(const TriMesh& input, const SimplifyOptions& options, const Resolution& resolution,
+                            const ProgressFn& progress, Clock::time_point start);
+
+/// Moves every row of X to its closest point on the locator's surface.
+void reproject_onto(const SurfaceLocator& surface, RowMatrixX3d& X);
+
+/// Quality and distance to the original input, into level.stats.
+void measure_level(const TriMesh& original, const SurfaceLocator& locator, const RowMatrixX3i& F, RemeshLevel& level);
+
+}  // namespace mrsnake::remesh_stages
