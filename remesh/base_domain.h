@@ -28,10 +28,12 @@ struct BasePoint {
 
 /// The conformal flattening of a vertex star (MAPS, section 3.2): the ring vertices r_0..r_{k-1}
 /// (in counter-clockwise order seen from outside) around a centre c go to
-/// ρ·(|r_i - c|/ρ)^a · (cos(a·φ_i), sin(a·φ_i)), ρ the mean of the |r_i - c|, with φ_i the sum of the 3D angles at c of
-/// the triangles (c, r_0, r_1) … (c, r_{i-1}, r_i), and a = 2π / (the total angle) for an interior vertex (`closed`:
-/// the ring closes, r_{k-1} -> r_0 is a triangle too), π / (the total angle) on a boundary (the ring runs from one
-/// boundary neighbour to the other). \pre ring has at least 3 vertices (2 on a boundary), none at c.
+/// ρ·(|r_i - c|/ρ)^a · (cos(a·φ_i), sin(a·φ_i)), ρ the mean of the |r_i - c|, with φ_i the sum
+/// of the 3D angles at c of the triangles (c, r_0, r_1) … (c, r_{i-1}, r_i), and
+/// a = 2π / (the total angle) for an interior vertex (`closed`: the ring closes, r_{k-1} -> r_0
+/// is a triangle too), π / (the total angle) on a boundary (the ring runs from one boundary
+/// neighbour to the other).
+/// \pre ring has at least 3 vertices (2 on a boundary), none at c.
 std::vector<Eigen::Vector2d> flatten_star(const Eigen::Vector3d& center, const std::vector<Eigen::Vector3d>& ring,
                                           bool closed);
 
