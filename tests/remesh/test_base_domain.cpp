@@ -1,9 +1,13 @@
-// Tests of the base-mesh domain: the conformal star flattening and the charts of BaseDomain
-// (round trips, points on shared edges, orientation, common charts).
+// Tests of the base-mesh domain: the conformal star flattening, the charts of BaseDomain
+// (round trips, points on shared edges, orientation, common charts) and the inverse map
+// BaseLift on a sphere parameterized by central projection onto an icosahedron, where the
+// answer is known.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -14,6 +18,7 @@
 #include "mesh/topology.h"
 #include "mesh/vertex_stars.h"
 #include "remesh/base_domain.h"
+#include "remesh/base_lift.h"
 #include "tests/remesh/remesh_shapes.h"
 
 namespace mrsnake {
@@ -266,6 +271,137 @@ TEST(BaseDomain, ThrowsOnANonManifoldVertex) {
   bowtie.F.resize(8, 3);
   bowtie.F << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3, 0, 5, 4, 0, 4, 6, 0, 6, 5, 4, 5, 6;
   EXPECT_THROW(BaseDomain{bowtie}, TopologyError);
+}
+
+// The K face hit by the ray from the origin through x, and the barycentric coordinates there.
+BasePoint central_projection(const TriMesh& K, const Eigen::Vector3d& x) {
+  BasePoint best;
+  double best_min = -1e300;
+  for (int f = 0; f < K.num_faces(); ++f) {
+    Eigen::Matrix3d corners;
+    for (int k = 0; k < 3; ++k) corners.col(k) = K.V.row(K.F(f, k)).transpose();
+    Eigen::Vector3d bary = corners.inverse() * x;
+    if (bary.sum() <= 0) continue;
+    bary /= bary.sum();
+    if (bary.minCoeff() > best_min) best_min = bary.minCoeff(), best = BasePoint{f, bary};
+  }
+  best.bary = best.bary.cwiseMax(0.0);
+  best.bary /= best.bary.sum();
+  return best;
+}
+
+// The sphere icosphere(3) parameterized over the icosahedron by central projection; `rotation`
+// turns the input so that its triangles straddle the icosahedron's edges.
+struct CentralSetup {
+  explicit CentralSetup(const Eigen::Matrix3d& rotation) : domain(icosphere(0)) {
+    input.V = input.V * rotation.transpose();
+    for (int v = 0; v < input.num_vertices(); ++v)
+      location.push_back(central_projection(domain.base(), input.V.row(v).transpose()));
+  }
+  TriMesh input = icosphere(3);
+  BaseDomain domain;
+  std::vector<BasePoint> location;
+  double edge = (input.V.row(input.F(0, 0)) - input.V.row(input.F(0, 1))).norm();
+};
+
+// Over random points p of D: the largest angle between lift(p) and the direction of p on K,
+// and the largest distance from p to the point of D the hit stands for (its coordinates
+// applied to its corners' locations, in their common chart). Every hit is a face with valid
+// coordinates. `gaps` counts the points off their hit by more than rounding.
+struct LiftErrors {
+  double angle = 0, domain = 0;
+  int gaps = 0;
+};
+void add_lift_errors(const CentralSetup& s, const BaseLift& lift, int samples, LiftErrors& worst) {
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> face(0, s.domain.base().num_faces() - 1);
+  for (int i = 0; i < samples; ++i) {
+    const BasePoint p{face(rng), random_bary(rng)};
+    const BaseLift::Hit hit = lift.locate(p);
+    EXPECT_TRUE(hit.face >= 0 && hit.face < s.input.num_faces());
+    EXPECT_GE(hit.bary.minCoeff(), 0);
+    EXPECT_NEAR(hit.bary.sum(), 1, 1e-12);
+    const Eigen::Vector3d x = lift.lift(p);
+    EXPECT_LE(x.norm(), 1 + 1e-12);
+    EXPECT_GE(x.norm(), 1 - s.edge * s.edge);  // on a chord triangle of the unit sphere
+    const BasePoint corners[3] = {s.location[s.input.F(hit.face, 0)], s.location[s.input.F(hit.face, 1)],
+                                  s.location[s.input.F(hit.face, 2)]};
+    const int chart = s.domain.common_chart(corners, 3);
+    ASSERT_TRUE(chart >= 0 && s.domain.in_star(chart, p));
+    Eigen::Vector2d in_chart = Eigen::Vector2d::Zero();
+    for (int k = 0; k < 3; ++k) in_chart += hit.bary[k] * s.domain.to_chart(chart, corners[k]);
+    worst.angle = std::max(worst.angle, angle_3d(x, s.domain.position(p)));
+    const double off = (in_chart - s.domain.to_chart(chart, p)).norm();
+    worst.domain = std::max(worst.domain, off);
+    if (off > 1e-12) ++worst.gaps;
+  }
+}
+
+void expect_vertices_lift_to_themselves(const CentralSetup& s, const BaseLift& lift) {
+  for (int v = 0; v < s.input.num_vertices(); ++v)
+    EXPECT_LT((lift.lift(s.location[v]) - s.input.V.row(v).transpose()).norm(), 1e-9) << "vertex " << v;
+}
+
+// Aligned, every input triangle lies in one face of K, on which all charts agree up to an
+// affine map: the triangles tile D, and the hit stands for p exactly. The lift is linear on
+// each triangle where central projection is projective: they differ by a small fraction of an
+// edge.
+TEST(BaseLift, FindsTheExactTriangleWhenTrianglesLieInBaseFaces) {
+  const CentralSetup s(Eigen::Matrix3d::Identity());
+  const BaseLift lift(s.input, s.domain, s.location);
+  EXPECT_EQ(lift.unmapped_triangles(), 0);
+  expect_vertices_lift_to_themselves(s, lift);
+  LiftErrors worst;
+  add_lift_errors(s, lift, 5000, worst);
+  std::printf("aligned: largest angle %.3g rad, domain error %.3g (edge %.3g)\n", worst.angle, worst.domain, s.edge);
+  EXPECT_EQ(worst.gaps, 0);
+  EXPECT_LT(worst.domain, 1e-12);
+  EXPECT_LT(worst.angle, 0.05 * s.edge);
+}
+
+// Rotated, triangles straddle K's edges, each straight in its own chart only: where the chart
+// switches from one end of a K edge to the other (near its midpoint), neighbours disagree and
+// leave narrow gaps, whose points get the nearest triangle. Elsewhere the hit is exact, the
+// lift stays within a fraction of an edge of central projection's inverse, and vertices still
+// lift exactly.
+TEST(BaseLift, InvertsCentralProjectionToWithinAnEdgeWhenTrianglesStraddleBaseEdges) {
+  const CentralSetup s(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix());
+  const BaseLift lift(s.input, s.domain, s.location);
+  EXPECT_EQ(lift.unmapped_triangles(), 0);
+  expect_vertices_lift_to_themselves(s, lift);
+  LiftErrors worst;
+  add_lift_errors(s, lift, 20000, worst);
+  std::printf("rotated: largest angle %.3g rad, domain error %.3g (edge %.3g), %d of 20000 points in gaps\n",
+              worst.angle, worst.domain, s.edge, worst.gaps);
+  EXPECT_LT(worst.angle, 0.25 * s.edge);
+  EXPECT_LT(worst.domain, 0.15 * s.edge);
+  EXPECT_LT(worst.gaps, 20000 / 100);
+
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> face(0, s.domain.base().num_faces() - 1);
+  std::vector<BasePoint> points;
+  for (int i = 0; i < 100000; ++i) points.push_back(BasePoint{face(rng), random_bary(rng)});
+  const auto start = std::chrono::steady_clock::now();
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const BasePoint& p : points) sum += lift.lift(p);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("lift of %zu points: %.1f ms (%.2f us per point; checksum %.3f)\n", points.size(), 1e3 * seconds,
+              1e6 * seconds / points.size(), sum.norm());
+}
+
+// A vertex located on the far side of K leaves its triangles without a common chart: they are
+// counted and skipped, and a point in the hole they leave gets a nearby triangle, clamped.
+TEST(BaseLift, SkipsTrianglesWithNoCommonChartAndFillsTheirHole) {
+  CentralSetup s(Eigen::Matrix3d::Identity());
+  const int moved = 500;
+  const BasePoint original = s.location[moved];
+  s.location[moved] = central_projection(s.domain.base(), -s.input.V.row(moved).transpose());
+  const BaseLift lift(s.input, s.domain, s.location);
+  EXPECT_EQ(lift.unmapped_triangles(), 6);
+  const BaseLift::Hit hit = lift.locate(original);
+  EXPECT_GE(hit.bary.minCoeff(), 0);
+  EXPECT_NEAR(hit.bary.sum(), 1, 1e-12);
+  EXPECT_LT((lift.lift(original) - s.input.V.row(moved).transpose()).norm(), 2 * s.edge);
 }
 
 }  // namespace
