@@ -28,11 +28,94 @@ struct BasePoint {
 
 /// The conformal flattening of a vertex star (MAPS, section 3.2): the ring vertices r_0..r_{k-1}
 /// (in counter-clockwise order seen from outside) around a centre c go to
-/// ρ·(|r_i - c|/ρ)^a · (cos(a·φ_i), sin(a·φ_i)), ρ the mean of the |r_i - c|, with φ_i the sum of the 3D angles at c of
-/// the triangles (c, r_0, r_1) … (c, r_{i-1}, r_i), and a = 2π / (the total angle) for an interior vertex (`closed`:
-/// the ring closes, r_{k-1} -> r_0 is a triangle too), π / (the total angle) on a boundary (the ring runs from one
-/// boundary neighbour to the other). \pre ring has at least 3 vertices (2 on a boundary), none at c.
+/// ρ·(|r_i - c|/ρ)^a · (cos(a·φ_i), sin(a·φ_i)), ρ the mean of the |r_i - c|, with φ_i the sum
+/// of the 3D angles at c of the triangles (c, r_0, r_1) … (c, r_{i-1}, r_i), and
+/// a = 2π / (the total angle) for an interior vertex (`closed`: the ring closes, r_{k-1} -> r_0
+/// is a triangle too), π / (the total angle) on a boundary (the ring runs from one boundary
+/// neighbour to the other).
+/// \pre ring has at least 3 vertices (2 on a boundary), none at c.
 std::vector<Eigen::Vector2d> flatten_star(const Eigen::Vector3d& center, const std::vector<Eigen::Vector3d>& ring,
                                           bool closed);
+
+/// The base mesh K as the domain, with one chart per vertex (flatten_star of its ring, v at
+/// the origin, each star face a straight triangle). A boundary vertex with a single face keeps
+/// that face's own shape: spanning π would flatten it to a segment.
+class BaseDomain {
+ public:
+  /// Precomputes every vertex's ordered star and its faces' corners in the vertex's chart.
+  /// \pre base is a closed genus-0 manifold or a disk, consistently oriented, no unreferenced
+  ///      vertices, no vertex at a neighbour's position.
+  /// \throw TopologyError if a vertex's faces are not a single fan (non-manifold), or none.
+  explicit BaseDomain(TriMesh base);
+
+  const TriMesh& base() const { return base_; }
+
+  /// The 3D point of p on K: its face's corners weighted by p.bary.
+  /// \pre p.face is a face of K.
+  /// \throw nothing.
+  Eigen::Vector3d position(const BasePoint& p) const;
+
+  /// K's vertex v as a point: the first face of its star, with unit weight on v.
+  /// \pre v is a vertex of K.
+  /// \throw nothing.
+  BasePoint vertex_point(int v) const;
+
+  /// Whether v's star holds p: p's face is in the star, or the corners of p's face that carry
+  /// weight (bary > kOnSimplex) are corners of one face of the star (p on a shared edge or vertex).
+  /// \pre v is a vertex of K, p a point of D.
+  /// \throw nothing.
+  bool in_star(int v, const BasePoint& p) const;
+
+  /// The K vertices whose star holds p (in_star): p's face's corners, and, for p on an edge or a
+  /// vertex of K, the corners of the other faces around it.
+  /// \pre p is a point of D.
+  /// \throw nothing beyond std::bad_alloc.
+  std::vector<int> charts_holding(const BasePoint& p) const;
+
+  /// p's position in v's chart. A point named by a face outside the star, but lying on an
+  /// edge or vertex the star shares, is placed by the star face that holds it.
+  /// \pre in_star(v, p).
+  /// \throw std::invalid_argument if p is not in v's star.
+  Eigen::Vector2d to_chart(int v, const BasePoint& p) const;
+
+  /// The point at q in v's chart: the star face holding q (barycentric coordinates >=
+  /// -kChartSlack, clamped to >= 0 and renormalized; the most inside face when q is on an
+  /// edge), or nullopt if q is outside the star.
+  /// \pre v is a vertex of K.
+  /// \throw nothing.
+  std::optional<BasePoint> from_chart(int v, const Eigen::Vector2d& q) const;
+
+  /// A K vertex whose star holds all `count` points, or -1 if none does. Of several, the one
+  /// nearest in 3D to the points' centroid: its chart is the least distorted around them.
+  /// \pre count >= 1; points[0 … count) are points of D.
+  /// \throw nothing beyond std::bad_alloc.
+  int common_chart(const BasePoint* points, int count) const;
+
+  /// The 2D cross product of (b − a, c − a) in the common chart of the three points (> 0 when
+  /// a, b, c run counter-clockwise seen from outside), NaN when they have none.
+  /// \pre a, b, c are points of D.
+  /// \throw nothing beyond std::bad_alloc.
+  double orientation(const BasePoint& a, const BasePoint& b, const BasePoint& c) const;
+
+  /// Barycentric coordinates at most this are treated as 0 when deciding which simplex of K
+  /// holds a point (in_star).
+  static constexpr double kOnSimplex = 1e-12;
+  /// How far below 0 a barycentric coordinate may be for from_chart to accept a point.
+  static constexpr double kChartSlack = 1e-9;
+
+ private:
+  /// The index in the star arrays of the face of v's star holding p, and p's barycentric
+  /// coordinates in that face (its corner order); -1 if v's star does not hold p.
+  int star_slot(int v, const BasePoint& p, Eigen::Vector3d& bary) const;
+
+  TriMesh base_;
+  /// Vertex v's star, counter-clockwise from outside (from one boundary neighbour to the other
+  /// on a boundary): entries star_offset_[v] … star_offset_[v + 1] − 1 of the arrays below.
+  std::vector<int> star_offset_, star_face_;
+  /// Per star entry, the chart positions of the face's corners (column k: corner k of the face).
+  std::vector<Eigen::Matrix<double, 2, 3>> star_corners_;
+  /// slot_(f, k): the star entry of face f in the star of its corner k.
+  RowMatrixX3i slot_;
+};
 
 }  // namespace mrsnake
