@@ -128,7 +128,8 @@ double expect_local_map(const TriMesh& input, const MapsParameterization& maps) 
     far_apart += common.empty();
     for (int j = 0; j < 3; ++j) over_a_ring += !within_a_ring(near[j], near[(j + 1) % 3], edges);
   }
-  EXPECT_LE(far_apart, input.num_faces() / 500) << "input triangles whose corners land in faces of K without a common vertex";
+  EXPECT_LE(far_apart, input.num_faces() / 500)
+      << "input triangles whose corners land in faces of K without a common vertex";
   EXPECT_EQ(over_a_ring, 0) << "input edges whose ends land more than one ring of K apart";
   double worst = 0;
   for (int v = 0; v < input.num_vertices(); ++v) {
