@@ -112,6 +112,7 @@ struct Options {
   double timeout = 1800;
   int repeat = 3;                 ///< timed runs per method and case; the medians are reported
   std::string markdown;           ///< also write the table as a Markdown page here (empty: no)
+  std::string config;             ///< `mrsnake remesh --config` of the mrsnake rows (empty: the defaults)
   std::vector<std::string> argv;  ///< this process's command line, for the Markdown page
 };
 
@@ -158,7 +159,8 @@ int parse_count(std::string s) {
                "  --iterations N    CGAL isotropic_remeshing iterations (default 10)\n"
                "  --timeout S       per mrsnake run (default 1800)\n"
                "  --repeat N        timed runs of each method per case; medians are reported (default 3)\n"
-               "  --markdown FILE   also write the table as a Markdown page (commit, machine, command)\n";
+               "  --markdown FILE   also write the table as a Markdown page (commit, machine, command)\n"
+               "  --config FILE     options of the mrsnake rows (mrsnake remesh --config; default: none)\n";
   std::exit(error.empty() ? 0 : 2);
 }
 
@@ -197,6 +199,8 @@ Options parse_options(int argc, char** argv) {
         o.repeat = std::stoi(value());
       else if (arg == "--markdown")
         o.markdown = value();
+      else if (arg == "--config")
+        o.config = value();
       else if (arg == "-h" || arg == "--help")
         usage("");
       else
@@ -636,6 +640,10 @@ Row run_mrsnake_remesh(const Options& o, const std::string& name, const std::str
   std::vector<std::string> args = {o.mrsnake, "-q",         "remesh",  input_path,
                                    "-o",      dir.string(), "--faces", std::to_string(target)};
   if (!relax) args.push_back("--no-relax");
+  if (!o.config.empty()) {
+    args.push_back("--config");
+    args.push_back(o.config);
+  }
   // Beside the folder, not in it: remesh replaces only a folder of its own outputs, and
   // writes it whole (a temporary folder renamed at the end).
   const std::string log = dir.string() + ".log";

@@ -75,23 +75,31 @@ std::vector<Eigen::Vector2d> flatten_star(const Eigen::Vector3d& center, const s
                                           bool closed) {
   const int k = static_cast<int>(ring.size());
   const int wedges = closed ? k : k - 1;
-  std::vector<double> phi(k, 0.0);
-  double total = 0;
+  std::vector<double> wedge(wedges);
+  double total = 0, widest = 0;
   for (int i = 0; i < wedges; ++i) {
     const Eigen::Vector3d a = ring[i] - center, b = ring[(i + 1) % k] - center;
     // atan2 of |a×b| and a·b: accurate for angles near 0 and π, where acos is not.
-    total += std::atan2(a.cross(b).norm(), a.dot(b));
-    if (i + 1 < k) phi[i + 1] = total;
+    wedge[i] = std::atan2(a.cross(b).norm(), a.dot(b));
+    total += wedge[i];
+    widest = std::max(widest, wedge[i]);
   }
-  const double a = (closed ? 2 * M_PI : M_PI) / total;
+  const double span = closed ? 2 * M_PI : M_PI;
+  const double a = span / total;
+  // A wedge scaled past π would fold the chart (a sharp tip with one wide angle): blend the
+  // scaled wedges toward equal ones just enough that none exceeds kWidestWedge.
+  const double even = span / wedges, scaled_widest = a * widest;
+  const double t = scaled_widest > kWidestWedge ? (scaled_widest - kWidestWedge) / (scaled_widest - even) : 0.0;
   // Radii relative to their mean before the power, so that the chart keeps the star's size
   // and a sharp tip (a large a) does not underflow: a scaling does not change the shapes.
   double mean_radius = 0;
   for (const Eigen::Vector3d& r : ring) mean_radius += (r - center).norm() / k;
   std::vector<Eigen::Vector2d> flat(k);
+  double phi = 0;
   for (int i = 0; i < k; ++i) {
     const double r = mean_radius * std::pow((ring[i] - center).norm() / mean_radius, a);
-    flat[i] = r * Eigen::Vector2d(std::cos(a * phi[i]), std::sin(a * phi[i]));
+    flat[i] = r * Eigen::Vector2d(std::cos(phi), std::sin(phi));
+    if (i < wedges) phi += (1 - t) * a * wedge[i] + t * even;
   }
   return flat;
 }
@@ -206,18 +214,34 @@ std::optional<BasePoint> BaseDomain::from_chart(int v, const Eigen::Vector2d& q)
   return BasePoint{star_face_[best], best_bary / best_bary.sum()};
 }
 
+double BaseDomain::depth(int v, const BasePoint& p) const {
+  Eigen::Vector3d bary;
+  const int slot = star_slot(v, p, bary);
+  if (slot < 0) return -1;
+  return bary[corner_of(base_.F, star_face_[slot], v)];
+}
+
 int BaseDomain::common_chart(const BasePoint* points, int count) const {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (int i = 0; i < count; ++i) centroid += position(points[i]) / count;
   int best = -1;
-  double best_distance = std::numeric_limits<double>::infinity();
-  // A chart holding all the points holds the first.
+  double best_depth = -1, best_distance = std::numeric_limits<double>::infinity();
+  // A chart holding all the points holds the first. The deepest chart first: three points on
+  // the rim of a star are held by it, but the straight triangle between them in that chart
+  // cuts across the star, while the face of K they span is outside it.
   for (int v : charts_holding(points[0])) {
+    double total_depth = 0;
     bool holds = true;
-    for (int i = 1; i < count && holds; ++i) holds = in_star(v, points[i]);
+    for (int i = 0; i < count && holds; ++i) {
+      const double d = depth(v, points[i]);
+      holds = d >= 0;
+      total_depth += d;
+    }
+    if (!holds) continue;
     const double distance = (base_.V.row(v).transpose() - centroid).squaredNorm();
-    if (!holds || distance >= best_distance) continue;
+    if (total_depth < best_depth || (total_depth == best_depth && distance >= best_distance)) continue;
     best = v;
+    best_depth = total_depth;
     best_distance = distance;
   }
   return best;
@@ -229,6 +253,15 @@ double BaseDomain::orientation(const BasePoint& a, const BasePoint& b, const Bas
   if (v < 0) return std::numeric_limits<double>::quiet_NaN();
   const Eigen::Vector2d qa = to_chart(v, a);
   return cross2(to_chart(v, b) - qa, to_chart(v, c) - qa);
+}
+
+bool BaseDomain::counter_clockwise(const BasePoint& a, const BasePoint& b, const BasePoint& c) const {
+  for (int v : charts_holding(a)) {
+    if (!in_star(v, b) || !in_star(v, c)) continue;
+    const Eigen::Vector2d qa = to_chart(v, a);
+    if (cross2(to_chart(v, b) - qa, to_chart(v, c) - qa) > 0) return true;
+  }
+  return false;
 }
 
 }  // namespace mrsnake

@@ -26,6 +26,9 @@ struct BasePoint {
   Eigen::Vector3d bary = Eigen::Vector3d(1.0 / 3, 1.0 / 3, 1.0 / 3);
 };
 
+/// The widest wedge of a vertex chart (radians), well short of π where it would fold.
+constexpr double kWidestWedge = 0.75 * 3.14159265358979323846;
+
 /// The conformal flattening of a vertex star (MAPS, section 3.2): the ring vertices r_0..r_{k-1}
 /// (in counter-clockwise order seen from outside) around a centre c go to
 /// ρ·(|r_i - c|/ρ)^a · (cos(a·φ_i), sin(a·φ_i)), ρ the mean of the |r_i - c|, with φ_i the sum
@@ -33,6 +36,8 @@ struct BasePoint {
 /// a = 2π / (the total angle) for an interior vertex (`closed`: the ring closes, r_{k-1} -> r_0
 /// is a triangle too), π / (the total angle) on a boundary (the ring runs from one boundary
 /// neighbour to the other).
+/// Where a scaled wedge would exceed kWidestWedge (it folds at π: a sharp tip with one wide
+/// angle), the wedges are blended toward equal ones just enough that none does.
 /// \pre ring has at least 3 vertices (2 on a boundary), none at c.
 std::vector<Eigen::Vector2d> flatten_star(const Eigen::Vector3d& center, const std::vector<Eigen::Vector3d>& ring,
                                           bool closed);
@@ -86,16 +91,31 @@ class BaseDomain {
   std::optional<BasePoint> from_chart(int v, const Eigen::Vector2d& q) const;
 
   /// A K vertex whose star holds all `count` points, or -1 if none does. Of several, the one
-  /// nearest in 3D to the points' centroid: its chart is the least distorted around them.
+  /// whose star holds them deepest (the largest sum of depth()), then the one nearest in 3D to
+  /// the points' centroid: its chart is the least distorted around them.
   /// \pre count >= 1; points[0 … count) are points of D.
   /// \throw nothing beyond std::bad_alloc.
   int common_chart(const BasePoint* points, int count) const;
+
+  /// p's weight on v in the star face of v that holds it: 1 at v, 0 on the star's rim; -1 if
+  /// the star does not hold p.
+  /// \pre v is a vertex of K, p a point of D.
+  double depth(int v, const BasePoint& p) const;
 
   /// The 2D cross product of (b − a, c − a) in the common chart of the three points (> 0 when
   /// a, b, c run counter-clockwise seen from outside), NaN when they have none.
   /// \pre a, b, c are points of D.
   /// \throw nothing beyond std::bad_alloc.
   double orientation(const BasePoint& a, const BasePoint& b, const BasePoint& c) const;
+
+  /// Whether some chart that holds a, b and c sees them counter-clockwise. Charts agree on the
+  /// orientation of a triangle inside one face of K (they differ there by an affine map that
+  /// keeps it); across an edge or a vertex of K, where they kink, a triangle small enough to be
+  /// nearly degenerate may be counter-clockwise in one and not in another, and it is not folded
+  /// while one chart holds it unfolded. A folded triangle is clockwise in all of them.
+  /// \pre a, b, c are points of D.
+  /// \throw nothing beyond std::bad_alloc.
+  bool counter_clockwise(const BasePoint& a, const BasePoint& b, const BasePoint& c) const;
 
   /// Barycentric coordinates at most this are treated as 0 when deciding which simplex of K
   /// holds a point (in_star).

@@ -46,6 +46,11 @@ class BaseLift {
   /// \pre as locate. \throw as locate.
   Eigen::Vector3d lift(const BasePoint& p) const;
 
+  const RowMatrixX3d& input_vertices() const { return V_; }
+  const RowMatrixX3i& input_faces() const { return F_; }
+  /// Input vertex i's point of D.
+  const BasePoint& location(int i) const { return location_[i]; }
+
   /// Input triangles not placed in any chart (no common chart, or degenerate in it).
   int unmapped_triangles() const { return unmapped_; }
 

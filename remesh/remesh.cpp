@@ -14,6 +14,7 @@
 #include "mesh/parallel.h"
 #include "mesh/quality.h"
 #include "remesh/base_mesh.h"
+#include "remesh/base_route.h"
 #include "remesh/domain.h"
 #include "remesh/feature_snap.h"
 #include "remesh/lift.h"
@@ -55,11 +56,8 @@ SizingFields sizing_fields(const TriMesh& surface, const SizingOptions& sizing, 
   int& n0 = resolution.base_vertices;
   const int n = surface.num_vertices();
   const Eigen::VectorXd kappa = vertex_curvature(surface, 8);
-  SizingFields s{Eigen::VectorXd::Ones(n), Eigen::VectorXd::Ones(n)};
-  if (const double mean = kappa.mean(); sizing.curvature_weight > 0 && mean > 0)
-    // Capped, so that a few sharp spots (voxel steps of a marching-cubes surface) cannot pull
-    // the spacing down so fast that triangle shapes suffer.
-    s.wanted.array() += sizing.curvature_weight * (kappa.array() / mean).pow(sizing.curvature_exponent).min(3.0);
+  SizingFields s{curvature_density(kappa, sizing.curvature_weight, sizing.curvature_exponent),
+                 Eigen::VectorXd::Ones(n)};
   // Averaged over about a base spacing (sqrt(n / n0) edge rings): the base follows where the
   // surface bends at its own scale, not voxel steps.
   if (base.density_exponent > 0) {
@@ -383,6 +381,7 @@ RemeshLevel build_level(const LevelContext& ctx, const RemeshOptions& options, i
 RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   check_options(options);
   if (input.empty()) throw InputError("the mesh has no faces");
+  if (options.domain == ParameterDomain::base_mesh) return remesh_on_base_mesh(input, options);
   RemeshResult result;
   const auto start = Clock::now();
   Resolution resolution = initial_resolution(options);

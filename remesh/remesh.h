@@ -30,6 +30,16 @@ enum class RelaxMode {
   none,               ///< no relaxation: plain 1:4 split in D (the paper's baseline, --no-relax)
 };
 
+/// The parameter domain D on which the levels are built and relaxed.
+enum class ParameterDomain {
+  /// The input mapped as a whole onto the unit sphere (closed) or the unit disk (a disk):
+  /// remesh/parameterization.h.
+  sphere,
+  /// The base mesh itself (MAPS, remesh/maps.h): the input simplified to the base, each patch
+  /// mapped onto its base triangle, so that D follows the shape (remesh/base_domain.h).
+  base_mesh,
+};
+
 /// Curvature sizing: where the levels should be denser than even in 3D (remesh/sizing.h).
 struct SizingOptions {
   /// The wanted 3D point density is w = 1 + curvature_weight·min((κ/mean κ)^curvature_exponent, 3):
@@ -121,6 +131,7 @@ struct RemeshOptions {
   /// Number of base vertices when `levels` is given (ignored with target_faces).
   int base_vertices = 32;
   RelaxMode relax = RelaxMode::all_vertices;
+  ParameterDomain domain = ParameterDomain::sphere;
   /// How a closed genus-0 input is mapped onto the sphere (remesh/parameterization.h).
   SphereMap sphere_map = SphereMap::automatic;
   SimplifyOptions simplify;

@@ -15,6 +15,10 @@ namespace mrsnake {
 void to_json(nlohmann::json& j, RelaxMode mode);
 void from_json(const nlohmann::json& j, RelaxMode& mode);
 
+/// "sphere", "base_mesh". \throw InputError on another string.
+void to_json(nlohmann::json& j, ParameterDomain domain);
+void from_json(const nlohmann::json& j, ParameterDomain& domain);
+
 /// "automatic", "punctured", "two_halves", "hierarchical". \throw InputError on another string.
 void to_json(nlohmann::json& j, SphereMap map);
 void from_json(const nlohmann::json& j, SphereMap& map);
@@ -31,7 +35,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RepairOptions, sweeps, threshold
                                                 error_tolerance, after_reprojection)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SurfaceFitOptions, rounds, regularization, max_offset,
                                                 max_sample_distance, quality_floor)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RemeshOptions, levels, target_faces, base_vertices, relax, sphere_map,
-                                                simplify, sizing, base, relaxation, snap, repair, fit)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RemeshOptions, levels, target_faces, base_vertices, relax, domain,
+                                                sphere_map, simplify, sizing, base, relaxation, snap, repair, fit)
 
 }  // namespace mrsnake

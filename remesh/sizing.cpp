@@ -87,4 +87,11 @@ Eigen::VectorXd bend_bounded_density(const TriMesh& mesh, const Eigen::VectorXd&
   return density.cwiseMax(floor / hi);
 }
 
+Eigen::VectorXd curvature_density(const Eigen::VectorXd& curvature, double weight, double exponent) {
+  Eigen::VectorXd wanted = Eigen::VectorXd::Ones(curvature.size());
+  if (const double mean = curvature.mean(); weight > 0 && mean > 0)
+    wanted.array() += weight * (curvature.array() / mean).pow(exponent).min(3.0);
+  return wanted;
+}
+
 }  // namespace mrsnake

@@ -13,6 +13,13 @@ namespace mrsnake {
 /// \pre mesh is a manifold triangle mesh without unreferenced vertices.
 Eigen::VectorXd vertex_curvature(const TriMesh& mesh, int smoothing = 3);
 
+/// The wanted relative point density 1 + weight·min((κ/mean κ)^exponent, 3) per vertex, κ the
+/// `curvature`: smaller triangles where the surface bends, whose chord error grows as κh².
+/// Capped, so that a few sharp spots (voxel steps of a marching-cubes surface) cannot pull the
+/// spacing down so fast that triangle shapes suffer. weight 0 (or a flat surface) = even.
+/// \pre weight >= 0, exponent > 0.
+Eigen::VectorXd curvature_density(const Eigen::VectorXd& curvature, double weight, double exponent);
+
 /// `field` (one value per vertex) averaged `passes` times over each vertex's 1-ring (itself
 /// included, each neighbour once per incident edge side).
 /// \pre field has one entry per vertex of mesh; passes >= 0.

@@ -250,7 +250,7 @@ TEST(Maps, KeepsEveryPointWithinTheDriftItIsAllowed) {
   options.base_vertices = 60;
   options.max_drift = 0.2;
   const MapsParameterization maps = maps_parameterize(input, options);
-  EXPECT_LE(maps.base.num_vertices(), 60);
+  EXPECT_LE(maps.base.num_vertices(), 2 * 60);  // the guard may stall it above the target
   EXPECT_GT(maps.refused_drift, 0);
   expect_oriented_manifold(maps.base, true);
   EXPECT_LE(expect_local_map(input, maps), 0.2 + 1e-9);

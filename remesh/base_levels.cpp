@@ -1,0 +1,246 @@
+#include "remesh/base_levels.h"
+
+#include <algorithm>
+#include <array>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <utility>
+
+#include <Eigen/Dense>
+
+#include "mesh/errors.h"
+#include "mesh/vertex_stars.h"
+#include "remesh/domain.h"
+#include "remesh/surface_moves.h"
+
+namespace mrsnake {
+namespace {
+
+double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+  const Eigen::Vector2d u = b - a, w = c - a;
+  return u.x() * w.y() - u.y() * w.x();
+}
+
+// The midpoint of the edge a -> b, whose faces are (a, b, left) and (b, a, right) (null on a
+// disk's rim), in the chart holding all four that sees both faces counter-clockwise, deepest
+// first: there the four halves of each face are counter-clockwise too. Else in any chart
+// holding a and b whose star holds the midpoint (a star is star-shaped, not convex).
+std::optional<BasePoint> edge_midpoint(const BaseDomain& domain, const BasePoint& a, const BasePoint& b,
+                                       const BasePoint* left, const BasePoint* right) {
+  std::optional<BasePoint> best, fallback;
+  double best_depth = -1;
+  for (const int c : domain.charts_holding(a)) {
+    if (!domain.in_star(c, b)) continue;
+    const Eigen::Vector2d qa = domain.to_chart(c, a), qb = domain.to_chart(c, b);
+    const std::optional<BasePoint> mid = domain.from_chart(c, 0.5 * (qa + qb));
+    if (!mid) continue;
+    if (!fallback) fallback = mid;
+    const bool left_ok = !left || (domain.in_star(c, *left) && cross2(qa, qb, domain.to_chart(c, *left)) > 0);
+    const bool right_ok = !right || (domain.in_star(c, *right) && cross2(qb, qa, domain.to_chart(c, *right)) > 0);
+    if (!left_ok || !right_ok) continue;
+    const double depth = domain.depth(c, a) + domain.depth(c, b) + (left ? domain.depth(c, *left) : 0.0) +
+                         (right ? domain.depth(c, *right) : 0.0);
+    if (depth > best_depth) {
+      best = mid;
+      best_depth = depth;
+    }
+  }
+  return best ? best : fallback;
+}
+
+// For each directed edge a -> b of F (key a·n + b), the vertex opposite it in its face.
+std::unordered_map<long long, int> edge_apexes(const RowMatrixX3i& F, int n) {
+  std::unordered_map<long long, int> apex;
+  apex.reserve(3 * F.rows());
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) apex[static_cast<long long>(F(f, k)) * n + F(f, (k + 1) % 3)] = F(f, (k + 2) % 3);
+  return apex;
+}
+
+// Vertex v's point and every corner of its star, for the chart that must hold them all.
+std::vector<BasePoint> star_points(const RowMatrixX3i& F, const VertexStars& stars, const BaseLayout& layout, int v) {
+  std::vector<BasePoint> points{layout.points[v]};
+  for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i)
+    for (int k = 0; k < 3; ++k)
+      if (F(stars.faces[i], k) != v) points.push_back(layout.points[F(stars.faces[i], k)]);
+  return points;
+}
+
+// The move in chart c whose lift is move_3d's part in the plane of the input triangle under p,
+// to first order; nullopt where that triangle is degenerate or not all in the chart.
+std::optional<Eigen::Vector2d> pull_back(const BaseDomain& domain, const BaseLift& lift, int c, const BasePoint& p,
+                                         const Eigen::Vector3d& move_3d) {
+  const BaseLift::Hit hit = lift.locate(p);
+  const RowMatrixX3i& F = lift.input_faces();
+  const RowMatrixX3d& V = lift.input_vertices();
+  Eigen::Matrix<double, 3, 2> edges_3d;
+  Eigen::Matrix2d edges_chart;
+  std::array<Eigen::Vector2d, 3> corner;
+  for (int k = 0; k < 3; ++k) {
+    const BasePoint& q = lift.location(F(hit.face, k));
+    if (!domain.in_star(c, q)) return std::nullopt;
+    corner[k] = domain.to_chart(c, q);
+  }
+  for (int k = 0; k < 2; ++k) {
+    edges_3d.col(k) = (V.row(F(hit.face, k + 1)) - V.row(F(hit.face, 0))).transpose();
+    edges_chart.col(k) = corner[k + 1] - corner[0];
+  }
+  const Eigen::Matrix2d gram = edges_3d.transpose() * edges_3d;
+  if (!(std::abs(gram.determinant()) > 0)) return std::nullopt;
+  return Eigen::Vector2d(edges_chart * gram.ldlt().solve(edges_3d.transpose() * move_3d));
+}
+
+// The triangles of v's star, with v at p, that are not counter-clockwise in the chart that
+// count_flipped_on_base tests them in: the measure of the invariant itself.
+int star_flips(const BaseDomain& domain, const RowMatrixX3i& F, const VertexStars& stars, const BaseLayout& layout,
+               int v, const BasePoint& p) {
+  int flips = 0;
+  for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
+    const int f = stars.faces[i];
+    BasePoint corner[3];
+    for (int k = 0; k < 3; ++k) corner[k] = F(f, k) == v ? p : layout.points[F(f, k)];
+    if (!domain.counter_clockwise(corner[0], corner[1], corner[2])) ++flips;
+  }
+  return flips;
+}
+
+// One vertex toward its target, by the largest of step, step/2, ... that keeps its star
+// unflipped and, with a floor, its smallest Q. Returns whether it moved.
+bool move_vertex(const RowMatrixX3i& F, const VertexStars& stars, const BaseDomain& domain, const BaseLift& lift,
+                 const BaseSmoothingOptions& options, const Eigen::VectorXd& density, int v, BaseLayout& layout) {
+  const std::vector<BasePoint> points = star_points(F, stars, layout, v);
+  const int c = domain.common_chart(points.data(), static_cast<int>(points.size()));
+  if (c < 0) return false;
+  const std::optional<Eigen::Vector3d> move = tangential_move(layout.X, F, stars, v, options.target, density);
+  if (!move) return false;
+  const std::optional<Eigen::Vector2d> chart_move = pull_back(domain, lift, c, layout.points[v], *move);
+  if (!chart_move) return false;
+  const Eigen::Vector2d start = domain.to_chart(c, layout.points[v]);
+  const Eigen::Vector3d x = layout.X.row(v);
+  const double floor =
+      options.quality_floor > 0 ? std::min(star_quality(layout.X, F, stars, v, x), options.quality_floor) : 0.0;
+  // Charts disagree a little across K's edges, so a split can leave a triangle flipped in its
+  // own chart: a move may keep such flips but never add one, and smoothing undoes them.
+  const int flips = star_flips(domain, F, stars, layout, v, layout.points[v]);
+  double t = options.step;
+  for (int attempt = 0; attempt < 6; ++attempt, t *= 0.5) {
+    const Eigen::Vector2d q = start + t * *chart_move;
+    const std::optional<BasePoint> p = domain.from_chart(c, q);
+    if (!p || star_flips(domain, F, stars, layout, v, *p) > flips) continue;
+    const Eigen::Vector3d lifted = lift.lift(*p);
+    if (flips == 0 && options.quality_floor > 0 && star_quality(layout.X, F, stars, v, lifted) < floor) continue;
+    layout.points[v] = *p;
+    layout.X.row(v) = lifted.transpose();
+    return true;
+  }
+  return false;
+}
+
+// The wanted density under each vertex of the layout: even without a surface density.
+Eigen::VectorXd density_under(const BaseLift& lift, const BaseLayout& layout, const Eigen::VectorXd* surface_density) {
+  const int n = static_cast<int>(layout.points.size());
+  Eigen::VectorXd density = Eigen::VectorXd::Ones(n);
+  if (!surface_density) return density;
+  const RowMatrixX3i& F = lift.input_faces();
+  for (int v = 0; v < n; ++v) {
+    const BaseLift::Hit hit = lift.locate(layout.points[v]);
+    density[v] = hit.bary[0] * (*surface_density)[F(hit.face, 0)] + hit.bary[1] * (*surface_density)[F(hit.face, 1)] +
+                 hit.bary[2] * (*surface_density)[F(hit.face, 2)];
+  }
+  return density;
+}
+
+// Vertex v to the mean of its ring in the chart that holds its star (Tutte's step: inside a
+// star-shaped ring it unfolds the star), if that leaves fewer flipped triangles around it.
+bool untangle_vertex(const RowMatrixX3i& F, const VertexStars& stars, const BaseDomain& domain, const BaseLift& lift,
+                     int v, BaseLayout& layout) {
+  const std::vector<BasePoint> points = star_points(F, stars, layout, v);
+  const int c = domain.common_chart(points.data(), static_cast<int>(points.size()));
+  if (c < 0) return false;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (std::size_t i = 1; i < points.size(); ++i) mean += domain.to_chart(c, points[i]) / (points.size() - 1.0);
+  const std::optional<BasePoint> p = domain.from_chart(c, mean);
+  if (!p || star_flips(domain, F, stars, layout, v, *p) >= star_flips(domain, F, stars, layout, v, layout.points[v]))
+    return false;
+  layout.points[v] = *p;
+  layout.X.row(v) = lift.lift(*p).transpose();
+  return true;
+}
+
+}  // namespace
+
+int untangle_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLift& lift, BaseLayout& layout,
+                     int sweeps) {
+  const int n = static_cast<int>(layout.points.size());
+  const VertexStars stars(F, n);
+  const std::vector<bool> rim = boundary_vertices(F, stars);
+  int moves = 0;
+  for (int sweep = 0; sweep < sweeps; ++sweep) {
+    std::vector<bool> tangled(n, false);
+    bool any = false;
+    for (int f = 0; f < F.rows(); ++f)
+      if (!domain.counter_clockwise(layout.points[F(f, 0)], layout.points[F(f, 1)], layout.points[F(f, 2)]))
+        for (int k = 0; k < 3; ++k) any = tangled[F(f, k)] = true;
+    if (!any) break;
+    for (int v = 0; v < n; ++v)
+      if (tangled[v] && !rim[v] && untangle_vertex(F, stars, domain, lift, v, layout)) ++moves;
+  }
+  return moves;
+}
+
+BaseLayout base_vertices_layout(const BaseDomain& domain, const BaseLift& lift) {
+  const int n0 = domain.base().num_vertices();
+  BaseLayout layout{std::vector<BasePoint>(n0), RowMatrixX3d(n0, 3)};
+  for (int v = 0; v < n0; ++v) {
+    layout.points[v] = domain.vertex_point(v);
+    layout.X.row(v) = lift.lift(layout.points[v]).transpose();
+  }
+  return layout;
+}
+
+void split_on_base(const SubdivisionConnectivity& connectivity, int j, const BaseDomain& domain, const BaseLift& lift,
+                   BaseLayout& layout) {
+  const int previous = connectivity.vertex_count(j - 1), n = connectivity.vertex_count(j);
+  layout.points.resize(n);
+  layout.X.conservativeResize(n, 3);
+  const std::unordered_map<long long, int> apex_of = edge_apexes(connectivity.faces[j - 1], previous);
+  for (int v = previous; v < n; ++v) {
+    const Eigen::Vector2i parents = connectivity.parents(v);
+    const auto apex = [&](int tail, int head) -> const BasePoint* {
+      const auto it = apex_of.find(static_cast<long long>(tail) * previous + head);
+      return it == apex_of.end() ? nullptr : &layout.points[it->second];
+    };
+    const std::optional<BasePoint> mid = edge_midpoint(domain, layout.points[parents[0]], layout.points[parents[1]],
+                                                       apex(parents[0], parents[1]), apex(parents[1], parents[0]));
+    if (!mid)
+      throw AlgorithmError("level " + std::to_string(j) + ": the edge " + std::to_string(parents[0]) + "-" +
+                           std::to_string(parents[1]) + " spans more than one chart of the base mesh");
+    layout.points[v] = *mid;
+    layout.X.row(v) = lift.lift(*mid).transpose();
+  }
+}
+
+int smooth_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLift& lift, BaseLayout& layout,
+                   const BaseSmoothingOptions& options) {
+  const int n = static_cast<int>(layout.points.size());
+  const VertexStars stars(F, n);
+  const std::vector<bool> rim = boundary_vertices(F, stars);
+  const bool weighted = options.target == SmoothingTarget::area_centroid && options.surface_density;
+  int moves = 0;
+  for (int it = 0; it < options.iterations; ++it) {
+    const Eigen::VectorXd density = density_under(lift, layout, weighted ? options.surface_density : nullptr);
+    for (int v = 0; v < n; ++v)
+      if (!rim[v] && move_vertex(F, stars, domain, lift, options, density, v, layout)) ++moves;
+  }
+  return moves;
+}
+
+int count_flipped_on_base(const BaseDomain& domain, const RowMatrixX3i& F, const std::vector<BasePoint>& points) {
+  int flipped = 0;
+  for (int f = 0; f < F.rows(); ++f)
+    if (!domain.counter_clockwise(points[F(f, 0)], points[F(f, 1)], points[F(f, 2)])) ++flipped;
+  return flipped;
+}
+
+}  // namespace mrsnake

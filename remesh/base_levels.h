@@ -1,0 +1,69 @@
+#pragma once
+/// \file base_levels.h
+/// The levels of the hierarchy built in the base-mesh domain (remesh/base_domain.h): the 1:4
+/// split of a level, its relaxation, and its flip test, all in the charts of K's vertices.
+///
+/// Without relaxation, every vertex of level j sits at dyadic barycentric coordinates of one
+/// face of K, and the hierarchy is the MAPS remesh. The relaxation moves vertices across K's
+/// edges and vertices freely: a move is computed in a chart that holds the vertex and its whole
+/// star, so K's edges are no seams. Each vertex aims at a 3D target (shape_smoothing.h), the
+/// 3D move is pulled back into the chart through the affine map of the input triangle under
+/// the vertex, and moves that would flip a triangle in the chart are halved until they do not.
+#include <vector>
+
+#include "mesh/subdivision.h"
+#include "mesh/trimesh.h"
+#include "remesh/base_domain.h"
+#include "remesh/base_lift.h"
+#include "remesh/shape_smoothing.h"
+
+namespace mrsnake {
+
+/// One level in the base domain: its points of D and their lifts onto the input.
+struct BaseLayout {
+  std::vector<BasePoint> points;
+  RowMatrixX3d X;
+};
+
+/// Level 0: K's vertices, lifted (onto the input vertices they are).
+BaseLayout base_vertices_layout(const BaseDomain& domain, const BaseLift& lift);
+
+/// Level j > 0 from level j − 1: each new vertex at the midpoint of its parents in a chart
+/// that holds both, lifted.
+/// \pre layout holds level j − 1 of `connectivity`.
+/// \throw AlgorithmError if two parents share no chart (the level is too coarse for K).
+void split_on_base(const SubdivisionConnectivity& connectivity, int j, const BaseDomain& domain, const BaseLift& lift,
+                   BaseLayout& layout);
+
+struct BaseSmoothingOptions {
+  int iterations = 6;
+  double step = 0.5;  ///< fraction of the way to the target per iteration
+  SmoothingTarget target = SmoothingTarget::equilateral_apexes;
+  /// area_centroid: the wanted 3D point density per vertex of the input the lift maps onto
+  /// (interpolated under each vertex). nullptr = even.
+  const Eigen::VectorXd* surface_density = nullptr;
+  /// A move is refused if it lowers the smallest Q of the vertex's triangles below
+  /// min(its value before, quality_floor). 0 = no check.
+  double quality_floor = 0;
+};
+
+/// Moves the interior vertices of (layout, F) toward `options.target`; disk rim vertices stay.
+/// \pre no triangle of F is flipped in D (count_flipped_on_base == 0).
+/// \post the same.
+/// \return the number of moves made.
+int smooth_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLift& lift, BaseLayout& layout,
+                   const BaseSmoothingOptions& options);
+
+/// Up to `sweeps` sweeps over the interior vertices of flipped triangles, each moved to the
+/// mean of its ring in the chart of its star where that leaves fewer flips around it: charts
+/// disagree a little across K's edges, so a split can fold a sliver that the chart its parent
+/// was tested in held unfolded.
+/// \return the number of moves made.
+int untangle_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLift& lift, BaseLayout& layout,
+                     int sweeps = 10);
+
+/// Triangles of F that no chart holding their corners sees counter-clockwise
+/// (BaseDomain::counter_clockwise): the flipped triangles in D.
+int count_flipped_on_base(const BaseDomain& domain, const RowMatrixX3i& F, const std::vector<BasePoint>& points);
+
+}  // namespace mrsnake

@@ -1,0 +1,181 @@
+#include "remesh/base_route.h"
+
+#include <memory>
+#include <string>
+#include <utility>
+
+#include "mesh/errors.h"
+#include "mesh/parallel.h"
+#include "remesh/base_domain.h"
+#include "remesh/base_levels.h"
+#include "remesh/base_lift.h"
+#include "remesh/domain.h"
+#include "remesh/maps.h"
+#include "remesh/remesh_stages.h"
+#include "remesh/sizing.h"
+#include "remesh/surface_fit.h"
+
+namespace mrsnake {
+namespace {
+
+using namespace remesh_stages;
+
+// The MAPS map of the prepared input, and the original's closest-point tree built on the other
+// core meanwhile.
+struct MappedOnBase {
+  MapsParameterization maps;
+  std::shared_ptr<SurfaceLocator> locator;
+};
+
+MappedOnBase map_onto_base(const PreparedInput& input, int base_vertices, bool needs_locator,
+                           const ProgressFn& progress) {
+  report(progress, "parameterize", 0);
+  MapsOptions options;
+  options.base_vertices = base_vertices;
+  MappedOnBase m;
+  run_both_in_parallel([&] { m.maps = maps_parameterize(input.work, options); },
+                       [&] {
+                         if (needs_locator) m.locator = std::make_shared<SurfaceLocator>(input.original);
+                       });
+  return m;
+}
+
+nlohmann::json base_summary(const MappedOnBase& mapped, const BaseLift& lift, const PreparedInput& input,
+                            Clock::time_point start) {
+  nlohmann::json s;
+  if (input.simplify_info.is_object()) s.update(input.simplify_info);
+  s["method"] = "MAPS: simplification to the base mesh, each patch mapped onto its base triangle";
+  s["domain"] = "base_mesh";
+  s["base_vertices"] = mapped.maps.base.num_vertices();
+  s["base_faces"] = mapped.maps.base.num_faces();
+  s["removed_vertices"] = mapped.maps.removed_vertices;
+  s["refused_removals"] = mapped.maps.refused_removals;
+  s["unmapped_triangles"] = lift.unmapped_triangles();
+  s["input_faces"] = input.original.num_faces();
+  s["parameterized_faces"] = input.work.num_faces();
+  s["seconds"] = seconds_since(start);
+  return s;
+}
+
+// What every level is built on.
+struct BaseContext {
+  const BaseDomain& domain;
+  const BaseLift& lift;
+  const TriMesh& original;
+  const SurfaceLocator* locator;    ///< the original's closest points, if built
+  const SurfaceLocator* reproject;  ///< the same, when a simplification was parameterized; else null
+  const SubdivisionConnectivity& connectivity;
+  const Eigen::VectorXd& wanted;  ///< the wanted 3D point density per vertex of the parameterized input
+};
+
+// Shapes first (equilateral apexes), then sizes with a quality floor (area centroids), as the
+// sphere route's shape smoothing and surface relaxation. Returns the moves.
+int relax_level(const BaseContext& ctx, const RelaxationOptions& options, int j, BaseLayout& layout) {
+  const RowMatrixX3i& F = ctx.connectivity.faces[j];
+  BaseSmoothingOptions shapes;
+  shapes.iterations = options.shape_iterations;
+  int moves = smooth_on_base(F, ctx.domain, ctx.lift, layout, shapes);
+  BaseSmoothingOptions sizes;
+  sizes.iterations = options.surface_iterations;
+  sizes.target = SmoothingTarget::area_centroid;
+  sizes.quality_floor = options.surface_quality_floor;
+  sizes.surface_density = &ctx.wanted;
+  moves += smooth_on_base(F, ctx.domain, ctx.lift, layout, sizes);
+  return moves;
+}
+
+// Level j: split (j > 0), relax in the charts of K (the full method), back onto the original
+// when a simplification was parameterized, the flip test in D, and the fit of the finest level.
+// \throw AlgorithmError if a triangle is flipped in D.
+// The layouts a level starts from: the split of the level before as relaxed, and as split
+// only (every vertex at dyadic barycentric coordinates of one face of K).
+struct LevelStart {
+  BaseLayout relaxed;
+  BaseLayout dyadic;
+};
+
+// Level j's starting layout. The relaxed level before, split and untangled, if that leaves no
+// flip; else the dyadic split, which has none: each of its triangles lies in one face of K,
+// where every chart is an affine image of the face. Charts disagree across K's edges, so the
+// split of a relaxed sliver can fold; the relaxation then never adds a flip.
+BaseLayout start_level(const BaseContext& ctx, int j, LevelStart& start) {
+  if (j == 0) return start.relaxed;
+  split_on_base(ctx.connectivity, j, ctx.domain, ctx.lift, start.dyadic);
+  split_on_base(ctx.connectivity, j, ctx.domain, ctx.lift, start.relaxed);
+  const RowMatrixX3i& F = ctx.connectivity.faces[j];
+  untangle_on_base(F, ctx.domain, ctx.lift, start.relaxed);
+  return count_flipped_on_base(ctx.domain, F, start.relaxed.points) == 0 ? start.relaxed : start.dyadic;
+}
+
+RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& options, int j, LevelStart& start,
+                             double extra_seconds) {
+  const auto clock_start = Clock::now();
+  const RowMatrixX3i& F = ctx.connectivity.faces[j];
+  const bool full = options.relax == RelaxMode::all_vertices;
+  BaseLayout layout = start_level(ctx, j, start);
+  // Level 0 is K: its vertices are where MAPS kept them, and its faces span whole charts.
+  const int moves = full && j > 0 ? relax_level(ctx, options.relaxation, j, layout) : 0;
+  RemeshLevel level;
+  level.positions = layout.X;
+  if (ctx.reproject) reproject_onto(*ctx.reproject, level.positions);
+  const int flipped = count_flipped_on_base(ctx.domain, F, layout.points);
+  if (flipped > 0)
+    throw AlgorithmError("level " + std::to_string(j) + " has " + std::to_string(flipped) +
+                         " flipped triangles in the base domain; the surface cannot be remeshed well");
+  nlohmann::json fit;
+  if (full && options.fit.rounds > 0 && j == ctx.connectivity.levels() && ctx.locator) {
+    const SurfaceFitStats s = fit_to_surface(F, level.positions, *ctx.locator, options.fit,
+                                             boundary_vertices(F, static_cast<int>(level.positions.rows())));
+    fit = {{"rms_before_mm", s.rms_before}, {"rms_after_mm", s.rms_after}, {"max_offset_mm", s.max_offset}};
+  }
+  level.domain_positions.resize(layout.points.size(), 3);
+  for (std::size_t v = 0; v < layout.points.size(); ++v)
+    level.domain_positions.row(v) = ctx.domain.position(layout.points[v]).transpose();
+  level.flipped_triangles = flipped;
+  start.relaxed = std::move(layout);
+  level.seconds = seconds_since(clock_start) + extra_seconds;
+  level.stats = {{"level", j},
+                 {"vertices", level.positions.rows()},
+                 {"faces", F.rows()},
+                 {"flipped_triangles", flipped},
+                 {"seconds", level.seconds},
+                 {"shape_moves", moves}};
+  if (!fit.is_null()) level.stats["fit"] = fit;
+  if (options.compute_stats && ctx.locator) measure_level(ctx.original, *ctx.locator, F, level);
+  return level;
+}
+
+}  // namespace
+
+RemeshResult remesh_on_base_mesh(const TriMesh& input, const RemeshOptions& options) {
+  RemeshResult result;
+  const auto start = Clock::now();
+  const Resolution resolution = initial_resolution(options);
+  const PreparedInput prepared = prepare_input(input, options.simplify, resolution, options.progress, start);
+  const bool needs_locator = prepared.simplified || options.relax == RelaxMode::all_vertices || options.compute_stats ||
+                             options.keep_input_locator;
+  const MappedOnBase mapped = map_onto_base(prepared, resolution.base_vertices, needs_locator, options.progress);
+  const BaseDomain domain(mapped.maps.base);
+  const BaseLift lift(prepared.work, domain, mapped.maps.location);
+  result.input_locator = mapped.locator;
+  result.domain = "base_mesh";
+  result.parameterization = base_summary(mapped, lift, prepared, start);
+  result.connectivity = subdivide_connectivity(mapped.maps.base.F, mapped.maps.base.num_vertices(), resolution.levels);
+  const Eigen::VectorXd wanted = curvature_density(vertex_curvature(prepared.work, 8), options.sizing.curvature_weight,
+                                                   options.sizing.curvature_exponent);
+  const BaseContext context{domain,
+                            lift,
+                            prepared.original,
+                            mapped.locator.get(),
+                            prepared.simplified ? mapped.locator.get() : nullptr,
+                            result.connectivity,
+                            wanted};
+  LevelStart level_start{base_vertices_layout(domain, lift), base_vertices_layout(domain, lift)};
+  for (int j = 0; j <= resolution.levels; ++j) {
+    result.levels.push_back(build_base_level(context, options, j, level_start, 0.0));
+    report(options.progress, "level " + std::to_string(j), 1.0);
+  }
+  return result;
+}
+
+}  // namespace mrsnake
