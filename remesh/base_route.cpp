@@ -98,13 +98,15 @@ struct LevelStart {
 // flip; else the dyadic split, which has none: each of its triangles lies in one face of K,
 // where every chart is an affine image of the face. Charts disagree across K's edges, so the
 // split of a relaxed sliver can fold; the relaxation then never adds a flip.
-BaseLayout start_level(const BaseContext& ctx, int j, LevelStart& start) {
+BaseLayout start_level(const BaseContext& ctx, int j, LevelStart& start, bool& dyadic) {
+  dyadic = j == 0;
   if (j == 0) return start.relaxed;
   split_on_base(ctx.connectivity, j, ctx.domain, ctx.lift, start.dyadic);
   split_on_base(ctx.connectivity, j, ctx.domain, ctx.lift, start.relaxed);
   const RowMatrixX3i& F = ctx.connectivity.faces[j];
   untangle_on_base(F, ctx.domain, ctx.lift, start.relaxed);
-  return count_flipped_on_base(ctx.domain, F, start.relaxed.points) == 0 ? start.relaxed : start.dyadic;
+  dyadic = count_flipped_on_base(ctx.domain, F, start.relaxed.points) > 0;
+  return dyadic ? start.dyadic : start.relaxed;
 }
 
 RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& options, int j, LevelStart& start,
@@ -112,7 +114,8 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
   const auto clock_start = Clock::now();
   const RowMatrixX3i& F = ctx.connectivity.faces[j];
   const bool full = options.relax == RelaxMode::all_vertices;
-  BaseLayout layout = start_level(ctx, j, start);
+  bool from_dyadic = false;
+  BaseLayout layout = start_level(ctx, j, start, from_dyadic);
   // Level 0 is K: its vertices are where MAPS kept them, and its faces span whole charts.
   const int moves = full && j > 0 ? relax_level(ctx, options.relaxation, j, layout) : 0;
   RemeshLevel level;
@@ -139,7 +142,8 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
                  {"faces", F.rows()},
                  {"flipped_triangles", flipped},
                  {"seconds", level.seconds},
-                 {"shape_moves", moves}};
+                 {"shape_moves", moves},
+                 {"started_from", from_dyadic ? "dyadic split" : "relaxed split"}};
   if (!fit.is_null()) level.stats["fit"] = fit;
   if (options.compute_stats && ctx.locator) measure_level(ctx.original, *ctx.locator, F, level);
   return level;
