@@ -33,10 +33,7 @@ MappedOnBase map_onto_base(const PreparedInput& input, int base_vertices, bool n
   MapsOptions options;
   options.base_vertices = base_vertices;
   MappedOnBase m;
-  run_both_in_parallel([&] { m.maps = maps_parameterize(input.work, options); },
-                       [&] {
-                         if (needs_locator) m.locator = std::make_shared<SurfaceLocator>(input.original);
-                       });
+  m.locator = map_beside_locator(input, needs_locator, [&] { m.maps = maps_parameterize(input.work, options); });
   return m;
 }
 

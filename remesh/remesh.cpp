@@ -124,10 +124,7 @@ MappedInput map_onto_domain(const PreparedInput& input, SphereMap sphere_map, bo
   ParameterizationOptions param_options;
   param_options.sphere_map = sphere_map;
   MappedInput m;
-  run_both_in_parallel([&] { m.param = parameterize(input.work, param_options); },
-                       [&] {
-                         if (needs_locator) m.locator = std::make_shared<SurfaceLocator>(input.original);
-                       });
+  m.locator = map_beside_locator(input, needs_locator, [&] { m.param = parameterize(input.work, param_options); });
   return m;
 }
 

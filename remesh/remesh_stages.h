@@ -4,10 +4,13 @@
 /// resolution, the preparation of the input, the reprojection onto it and the measures of a
 /// level. Internal to the remesh module.
 #include <chrono>
+#include <memory>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
 #include "mesh/distance.h"
+#include "mesh/parallel.h"
 #include "mesh/progress.h"
 #include "mesh/trimesh.h"
 #include "remesh/remesh.h"
@@ -42,6 +45,18 @@ struct PreparedInput {
 /// \throw TopologyError if the input is neither a disk nor a closed genus-0 surface.
 PreparedInput prepare_input(const TriMesh& input, const SimplifyOptions& options, const Resolution& resolution,
                             const ProgressFn& progress, Clock::time_point start);
+
+/// Runs `map` (the parameterization of input.work) on this core and, when needs_locator, builds
+/// the original's closest-point tree on the other meanwhile (for the reprojection, the fit and
+/// the report's distances). Returns the tree, or null.
+template <class Map>
+std::shared_ptr<SurfaceLocator> map_beside_locator(const PreparedInput& input, bool needs_locator, Map&& map) {
+  std::shared_ptr<SurfaceLocator> locator;
+  run_both_in_parallel(std::forward<Map>(map), [&] {
+    if (needs_locator) locator = std::make_shared<SurfaceLocator>(input.original);
+  });
+  return locator;
+}
 
 /// Moves every row of X to its closest point on the locator's surface.
 void reproject_onto(const SurfaceLocator& surface, RowMatrixX3d& X);
