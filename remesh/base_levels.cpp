@@ -91,6 +91,30 @@ std::optional<Eigen::Vector2d> pull_back(const BaseDomain& domain, const BaseLif
   return Eigen::Vector2d(edges_chart * gram.ldlt().solve(edges_3d.transpose() * move_3d));
 }
 
+// The move in chart c whose lift is move_3d's tangential part, to first order, from the
+// level's own star: the linear map that best takes the 3D edges from v (in the tangent plane
+// of `normal`) to the same edges in the chart. For a vertex whose input triangle reaches out of
+// the chart. nullopt where the star is degenerate in 3D.
+std::optional<Eigen::Vector2d> pull_back_by_star(const BaseDomain& domain, const RowMatrixX3i& F,
+                                                 const VertexStars& stars, const BaseLayout& layout, int c, int v,
+                                                 const Eigen::Vector3d& normal, const Eigen::Vector3d& move_3d) {
+  const Eigen::Vector3d t1 = normal.unitOrthogonal(), t2 = normal.cross(t1);
+  const Eigen::Vector3d x = layout.X.row(v);
+  const Eigen::Vector2d q = domain.to_chart(c, layout.points[v]);
+  Eigen::Matrix2d edges_edges = Eigen::Matrix2d::Zero(), chart_edges = Eigen::Matrix2d::Zero();
+  for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i)
+    for (int k = 0; k < 3; ++k) {
+      const int w = F(stars.faces[i], k);
+      if (w == v) continue;
+      const Eigen::Vector3d e = layout.X.row(w).transpose() - x;
+      const Eigen::Vector2d d(t1.dot(e), t2.dot(e));
+      edges_edges += d * d.transpose();
+      chart_edges += (domain.to_chart(c, layout.points[w]) - q) * d.transpose();
+    }
+  if (!(std::abs(edges_edges.determinant()) > 0)) return std::nullopt;
+  return Eigen::Vector2d(chart_edges * edges_edges.inverse() * Eigen::Vector2d(t1.dot(move_3d), t2.dot(move_3d)));
+}
+
 // The triangles of v's star, with v at p, that are not counter-clockwise in the chart that
 // count_flipped_on_base tests them in: the measure of the invariant itself.
 int star_flips(const BaseDomain& domain, const RowMatrixX3i& F, const VertexStars& stars, const BaseLayout& layout,
@@ -114,7 +138,10 @@ bool move_vertex(const RowMatrixX3i& F, const VertexStars& stars, const BaseDoma
   if (c < 0) return false;
   const std::optional<Eigen::Vector3d> move = tangential_move(layout.X, F, stars, v, options.target, density);
   if (!move) return false;
-  const std::optional<Eigen::Vector2d> chart_move = pull_back(domain, lift, c, layout.points[v], *move);
+  std::optional<Eigen::Vector2d> chart_move = pull_back(domain, lift, c, layout.points[v], *move);
+  if (!chart_move)
+    if (const std::optional<Eigen::Vector3d> normal = vertex_normal(layout.X, F, stars, v))
+      chart_move = pull_back_by_star(domain, F, stars, layout, c, v, *normal, *move);
   if (!chart_move) return false;
   const Eigen::Vector2d start = domain.to_chart(c, layout.points[v]);
   const Eigen::Vector3d x = layout.X.row(v);
