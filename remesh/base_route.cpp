@@ -81,9 +81,6 @@ int relax_level(const BaseContext& ctx, const RelaxationOptions& options, int j,
   return moves;
 }
 
-// Level j: split (j > 0), relax in the charts of K (the full method), back onto the original
-// when a simplification was parameterized, the flip test in D, and the fit of the finest level.
-// \throw AlgorithmError if a triangle is flipped in D.
 // The layouts a level starts from: the split of the level before as relaxed, and as split
 // only (every vertex at dyadic barycentric coordinates of one face of K).
 struct LevelStart {
@@ -106,6 +103,9 @@ BaseLayout start_level(const BaseContext& ctx, int j, LevelStart& start, bool& d
   return dyadic ? start.dyadic : start.relaxed;
 }
 
+// Level j: its start (start_level), relax in the charts of K (the full method), back onto the original
+// when a simplification was parameterized, the flip test in D, and the fit of the finest level.
+// \throw AlgorithmError if a triangle is flipped in D.
 RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& options, int j, LevelStart& start,
                              double extra_seconds) {
   const auto clock_start = Clock::now();
