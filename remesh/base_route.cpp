@@ -88,33 +88,45 @@ struct LevelStart {
   BaseLayout dyadic;
 };
 
-// Level j's starting layout. The relaxed level before, split and untangled, if that leaves no
-// flip; else the dyadic split, which has none: each of its triangles lies in one face of K,
-// where every chart is an affine image of the face. Charts disagree across K's edges, so the
-// split of a relaxed sliver can fold; the relaxation then never adds a flip.
-BaseLayout start_level(const BaseContext& ctx, int j, LevelStart& start, bool& dyadic) {
-  dyadic = j == 0;
-  if (j == 0) return start.relaxed;
+// Level j laid out: the relaxed level before, split, untangled and relaxed, if that leaves no
+// flip; else the dyadic split relaxed, which starts with none: each of its triangles lies in
+// one face of K, where every chart is an affine image of the face. Charts disagree across K's
+// edges, so the split of a relaxed sliver can fold; the relaxation never adds a flip and mostly
+// undoes the folds it starts with.
+struct LaidOutLevel {
+  BaseLayout layout;
+  int moves = 0;
+  bool from_dyadic = false;
+};
+
+LaidOutLevel lay_out_level(const BaseContext& ctx, const RemeshOptions& options, int j, LevelStart& start) {
+  if (j == 0) return {start.relaxed, 0, true};  // K: its vertices where MAPS kept them
+  const RowMatrixX3i& F = ctx.connectivity.faces[j];
+  const bool full = options.relax == RelaxMode::all_vertices;
+  const auto relaxed = [&](BaseLayout layout) {
+    const int moves = full ? relax_level(ctx, options.relaxation, j, layout) : 0;
+    return LaidOutLevel{std::move(layout), moves, false};
+  };
   split_on_base(ctx.connectivity, j, ctx.domain, ctx.lift, start.dyadic);
   split_on_base(ctx.connectivity, j, ctx.domain, ctx.lift, start.relaxed);
-  const RowMatrixX3i& F = ctx.connectivity.faces[j];
   untangle_on_base(F, ctx.domain, ctx.lift, start.relaxed);
-  dyadic = count_flipped_on_base(ctx.domain, F, start.relaxed.points) > 0;
-  return dyadic ? start.dyadic : start.relaxed;
+  LaidOutLevel level = relaxed(std::move(start.relaxed));
+  if (count_flipped_on_base(ctx.domain, F, level.layout.points) == 0) return level;
+  level = relaxed(start.dyadic);
+  level.from_dyadic = true;
+  return level;
 }
 
-// Level j: its start (start_level), relax in the charts of K (the full method), back onto the original
-// when a simplification was parameterized, the flip test in D, and the fit of the finest level.
+// Level j: laid out (lay_out_level), back onto the original when a simplification was
+// parameterized, the flip test in D, and the fit of the finest level.
 // \throw AlgorithmError if a triangle is flipped in D.
 RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& options, int j, LevelStart& start,
                              double extra_seconds) {
   const auto clock_start = Clock::now();
   const RowMatrixX3i& F = ctx.connectivity.faces[j];
   const bool full = options.relax == RelaxMode::all_vertices;
-  bool from_dyadic = false;
-  BaseLayout layout = start_level(ctx, j, start, from_dyadic);
-  // Level 0 is K: its vertices are where MAPS kept them, and its faces span whole charts.
-  const int moves = full && j > 0 ? relax_level(ctx, options.relaxation, j, layout) : 0;
+  LaidOutLevel laid_out = lay_out_level(ctx, options, j, start);
+  BaseLayout& layout = laid_out.layout;
   RemeshLevel level;
   level.positions = layout.X;
   if (ctx.reproject) reproject_onto(*ctx.reproject, level.positions);
@@ -139,8 +151,8 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
                  {"faces", F.rows()},
                  {"flipped_triangles", flipped},
                  {"seconds", level.seconds},
-                 {"shape_moves", moves},
-                 {"started_from", from_dyadic ? "dyadic split" : "relaxed split"}};
+                 {"shape_moves", laid_out.moves},
+                 {"started_from", laid_out.from_dyadic ? "dyadic split" : "relaxed split"}};
   if (!fit.is_null()) level.stats["fit"] = fit;
   if (options.compute_stats && ctx.locator) measure_level(ctx.original, *ctx.locator, F, level);
   return level;
