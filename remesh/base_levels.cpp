@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <unordered_map>
@@ -164,6 +165,44 @@ bool move_vertex(const RowMatrixX3i& F, const VertexStars& stars, const BaseDoma
   return false;
 }
 
+// Rim vertex v slid along the rim, between its rim neighbours a and b, toward the point that
+// splits the 3D lengths a–v and v–b evenly. It moves on the chart segment a–b, which is the rim
+// where the chart straightens it (a rim vertex of K flattens its rim to a line); where a, v and
+// b are not collinear in the chart (a corner of K with one face), v stays. Returns whether it
+// moved.
+bool slide_rim_vertex(const RowMatrixX3i& F, const VertexStars& stars, const BaseDomain& domain, const BaseLift& lift,
+                      const BaseSmoothingOptions& options, const Eigen::Vector2i& rim, int v, BaseLayout& layout) {
+  if (rim[0] < 0 || rim[1] < 0) return false;
+  const std::vector<BasePoint> points = star_points(F, stars, layout, v);
+  const int c = domain.common_chart(points.data(), static_cast<int>(points.size()));
+  if (c < 0 || !domain.in_star(c, layout.points[rim[0]]) || !domain.in_star(c, layout.points[rim[1]])) return false;
+  const Eigen::Vector2d qa = domain.to_chart(c, layout.points[rim[0]]), qb = domain.to_chart(c, layout.points[rim[1]]);
+  const Eigen::Vector2d qv = domain.to_chart(c, layout.points[v]), chord = qb - qa;
+  const double length2 = chord.squaredNorm();
+  const double s = (qv - qa).dot(chord) / length2;
+  if (!(length2 > 0) || !(s > 0 && s < 1) || std::abs(cross2(qa, qv, qb)) > 1e-9 * length2) return false;
+  // The 3D rim length as linear in s on each side: the s that evens the two.
+  const Eigen::Vector3d x = layout.X.row(v);
+  const double per_s_before = (x - layout.X.row(rim[0]).transpose()).norm() / s;
+  const double per_s_after = (x - layout.X.row(rim[1]).transpose()).norm() / (1 - s);
+  if (!(per_s_before + per_s_after > 0)) return false;
+  const double even = per_s_after / (per_s_before + per_s_after);
+  const double floor =
+      options.quality_floor > 0 ? std::min(star_quality(layout.X, F, stars, v, x), options.quality_floor) : 0.0;
+  const int flips = star_flips(domain, F, stars, layout, v, layout.points[v]);
+  double t = options.step;
+  for (int attempt = 0; attempt < 6; ++attempt, t *= 0.5) {
+    const std::optional<BasePoint> p = domain.from_chart(c, qa + (s + t * (even - s)) * chord);
+    if (!p || star_flips(domain, F, stars, layout, v, *p) > flips) continue;
+    const Eigen::Vector3d lifted = lift.lift(*p);
+    if (flips == 0 && options.quality_floor > 0 && star_quality(layout.X, F, stars, v, lifted) < floor) continue;
+    layout.points[v] = *p;
+    layout.X.row(v) = lifted.transpose();
+    return true;
+  }
+  return false;
+}
+
 // The wanted density under each vertex of the layout: even without a surface density.
 Eigen::VectorXd density_under(const BaseLift& lift, const BaseLayout& layout, const Eigen::VectorXd* surface_density) {
   const int n = static_cast<int>(layout.points.size());
@@ -252,13 +291,18 @@ int smooth_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLi
                    const BaseSmoothingOptions& options) {
   const int n = static_cast<int>(layout.points.size());
   const VertexStars stars(F, n);
-  const std::vector<bool> rim = boundary_vertices(F, stars);
+  const std::vector<Eigen::Vector2i> rim = rim_neighbours(boundary_edges(F, stars), n);
   const bool weighted = options.target == SmoothingTarget::area_centroid && options.surface_density;
   int moves = 0;
   for (int it = 0; it < options.iterations; ++it) {
     const Eigen::VectorXd density = density_under(lift, layout, weighted ? options.surface_density : nullptr);
-    for (int v = 0; v < n; ++v)
-      if (!rim[v] && move_vertex(F, stars, domain, lift, options, density, v, layout)) ++moves;
+    for (int v = 0; v < n; ++v) {
+      const bool on_rim = rim[v][0] >= 0 || rim[v][1] >= 0;
+      const bool moved = on_rim
+                             ? options.slide_rim && slide_rim_vertex(F, stars, domain, lift, options, rim[v], v, layout)
+                             : move_vertex(F, stars, domain, lift, options, density, v, layout);
+      if (moved) ++moves;
+    }
   }
   return moves;
 }

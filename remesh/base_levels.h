@@ -45,9 +45,12 @@ struct BaseSmoothingOptions {
   /// A move is refused if it lowers the smallest Q of the vertex's triangles below
   /// min(its value before, quality_floor). 0 = no check.
   double quality_floor = 0;
+  /// Disk rim vertices slide along the rim (evening the 3D rim lengths) instead of staying.
+  bool slide_rim = true;
 };
 
-/// Moves the interior vertices of (layout, F) toward `options.target`; disk rim vertices stay.
+/// Moves the interior vertices of (layout, F) toward `options.target`, and slides disk rim
+/// vertices along the rim (options.slide_rim).
 /// \pre no triangle of F is flipped in D (count_flipped_on_base == 0).
 /// \post the same.
 /// \return the number of moves made.

@@ -70,6 +70,15 @@ std::vector<std::pair<int, int>> boundary_edges(const RowMatrixX3i& F, const Ver
   return edges;
 }
 
+std::vector<Eigen::Vector2i> rim_neighbours(const std::vector<std::pair<int, int>>& rim_edges, int n) {
+  std::vector<Eigen::Vector2i> rim(n, Eigen::Vector2i(-1, -1));
+  for (const auto& [a, b] : rim_edges) {
+    rim[a][1] = b;  // a -> b runs along the boundary
+    rim[b][0] = a;
+  }
+  return rim;
+}
+
 std::vector<bool> boundary_vertices(const RowMatrixX3i& F, const VertexStars& stars) {
   std::vector<bool> boundary(stars.offset.size() - 1, false);
   for (const auto& [a, b] : boundary_edges(F, stars)) boundary[a] = boundary[b] = true;

@@ -36,6 +36,11 @@ int count_flipped(const RowMatrixX3d& D, const RowMatrixX3i& F);
 /// \pre `stars` are F's vertex stars.
 std::vector<std::pair<int, int>> boundary_edges(const RowMatrixX3i& F, const VertexStars& stars);
 
+/// For each vertex on `rim_edges` (boundary_edges), its neighbours along the boundary:
+/// (previous, next), -1 where there is none (every entry off the boundary).
+/// \pre every vertex of rim_edges is in [0, n).
+std::vector<Eigen::Vector2i> rim_neighbours(const std::vector<std::pair<int, int>>& rim_edges, int n);
+
 /// Vertices on a boundary edge (an edge used by one face).
 /// \pre `stars` are F's vertex stars.
 std::vector<bool> boundary_vertices(const RowMatrixX3i& F, const VertexStars& stars);

@@ -10,20 +10,6 @@
 #include "remesh/surface_moves.h"
 
 namespace mrsnake {
-namespace {
-
-// For each disk rim vertex, its two rim neighbours (previous and next along the boundary);
-// -1 elsewhere.
-std::vector<Eigen::Vector2i> rim_neighbours(const std::vector<std::pair<int, int>>& rim_edges, int n) {
-  std::vector<Eigen::Vector2i> rim(n, Eigen::Vector2i(-1, -1));
-  for (const auto& [a, b] : rim_edges) {
-    rim[a][1] = b;  // a -> b runs along the boundary
-    rim[b][0] = a;
-  }
-  return rim;
-}
-
-}  // namespace
 
 std::optional<Eigen::Vector3d> tangential_move(const RowMatrixX3d& X, const RowMatrixX3i& F, const VertexStars& stars,
                                                int v, SmoothingTarget target, const Eigen::VectorXd& vertex_density) {
