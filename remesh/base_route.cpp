@@ -54,6 +54,27 @@ nlohmann::json base_summary(const MappedOnBase& mapped, const BaseLift& lift, co
   return s;
 }
 
+// The lift is straight on each input triangle in one chart, and charts kink across K's edges,
+// so where input triangles are larger than the finest level's, nearby points of D lift through
+// different charts onto overlapping or gapped parts of a triangle, and the level's triangles
+// collapse or fold in 3D. Such an input is split 1:4 flat, which keeps its surface, until it
+// has at least twice the finest level's faces; `density` (per input vertex) is carried to the
+// new vertices as the mean of their parents'.
+void refine_coarse_input(PreparedInput& input, long long finest_faces, Eigen::VectorXd& density) {
+  int splits = 0;
+  for (long long faces = input.work.num_faces(); faces < 2 * finest_faces; faces *= 4) ++splits;
+  if (splits == 0) return;
+  const SubdivisionConnectivity c = subdivide_connectivity(input.work.F, input.work.num_vertices(), splits);
+  RowMatrixX3d V = input.work.V, w = RowMatrixX3d::Zero(density.size(), 3);
+  w.col(0) = density;
+  for (int j = 0; j < splits; ++j) {
+    V = midpoint_refine(c, j, V);
+    w = midpoint_refine(c, j, w);
+  }
+  input.work = TriMesh{V, c.faces[splits]};
+  density = w.col(0);
+}
+
 // What every level is built on.
 struct BaseContext {
   const BaseDomain& domain;
@@ -164,7 +185,11 @@ RemeshResult remesh_on_base_mesh(const TriMesh& input, const RemeshOptions& opti
   RemeshResult result;
   const auto start = Clock::now();
   const Resolution resolution = initial_resolution(options);
-  const PreparedInput prepared = prepare_input(input, options.simplify, resolution, options.progress, start);
+  PreparedInput prepared = prepare_input(input, options.simplify, resolution, options.progress, start);
+  Eigen::VectorXd wanted = curvature_density(vertex_curvature(prepared.work, 8), options.sizing.curvature_weight,
+                                             options.sizing.curvature_exponent);
+  const long long finest_faces = 2LL * (resolution.base_vertices - 2) << (2 * resolution.levels);
+  refine_coarse_input(prepared, finest_faces, wanted);
   const bool needs_locator = prepared.simplified || options.relax == RelaxMode::all_vertices || options.compute_stats ||
                              options.keep_input_locator;
   const MappedOnBase mapped = map_onto_base(prepared, resolution.base_vertices, needs_locator, options.progress);
@@ -174,8 +199,6 @@ RemeshResult remesh_on_base_mesh(const TriMesh& input, const RemeshOptions& opti
   result.domain = "base_mesh";
   result.parameterization = base_summary(mapped, lift, prepared, start);
   result.connectivity = subdivide_connectivity(mapped.maps.base.F, mapped.maps.base.num_vertices(), resolution.levels);
-  const Eigen::VectorXd wanted = curvature_density(vertex_curvature(prepared.work, 8), options.sizing.curvature_weight,
-                                                   options.sizing.curvature_exponent);
   const BaseContext context{domain,
                             lift,
                             prepared.original,

@@ -60,6 +60,22 @@ TEST(BaseDomainRemesh, ALongCapsuleNestsUnflippedAndWellShaped) {
   EXPECT_GT(q["min_angle_deg"].get<double>(), 20.0) << q.dump();
 }
 
+TEST(BaseDomainRemesh, ACoarseInputIsSplitFlatSoTheFinestLevelsTrianglesHoldTheirShape) {
+  // 320 faces for a finest level of about 5000: split 1:4 until it has twice the level's faces,
+  // on its own surface. Lifted through triangles larger than the level's, whose charts kink
+  // across K's edges, the finest level would have collapsed triangles.
+  const TriMesh input = test::ellipsoid(2);
+  const RemeshResult r = remesh(input, base_domain_options(5000));
+  const int finest = r.connectivity.levels();
+  const long long finest_faces = r.connectivity.faces[finest].rows();
+  long long split = input.num_faces();
+  while (split < 2 * finest_faces) split *= 4;
+  EXPECT_EQ(r.parameterization["parameterized_faces"].get<long long>(), split);
+  expect_valid_hierarchy(r, input);
+  const nlohmann::json q = mesh_quality(r.mesh(finest));
+  EXPECT_GT(q["min_angle_deg"].get<double>(), 20.0) << q.dump();
+}
+
 TEST(BaseDomainRemesh, WithoutRelaxationTheLevelsAreTheMapsRemesh) {
   RemeshOptions o = base_domain_options(2000);
   o.relax = RelaxMode::none;
