@@ -1,5 +1,6 @@
 #include "remesh/base_route.h"
 
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <utility>
@@ -37,8 +38,23 @@ MappedOnBase map_onto_base(const PreparedInput& input, int base_vertices, bool n
   return m;
 }
 
-nlohmann::json base_summary(const MappedOnBase& mapped, const BaseLift& lift, const PreparedInput& input,
-                            Clock::time_point start) {
+// How far K lies from the input it stands for: the largest distance from an input vertex to
+// its point on K, in K's mean edge lengths. Where K's faces cut across a protrusion, the
+// protrusion's points lie many edges away.
+double base_offset(const TriMesh& work, const MapsParameterization& maps, const BaseDomain& domain) {
+  const TriMesh& K = maps.base;
+  double edges = 0;
+  for (int f = 0; f < K.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) edges += (K.V.row(K.F(f, k)) - K.V.row(K.F(f, (k + 1) % 3))).norm();
+  const double mean_edge = edges / (3.0 * K.num_faces());
+  double largest = 0;
+  for (int v = 0; v < work.num_vertices(); ++v)
+    largest = std::max(largest, (work.V.row(v).transpose() - domain.position(maps.location[v])).norm());
+  return mean_edge > 0 ? largest / mean_edge : 0.0;
+}
+
+nlohmann::json base_summary(const MappedOnBase& mapped, const BaseDomain& domain, const BaseLift& lift,
+                            const PreparedInput& input, Clock::time_point start) {
   nlohmann::json s;
   if (input.simplify_info.is_object()) s.update(input.simplify_info);
   s["method"] = "MAPS: simplification to the base mesh, each patch mapped onto its base triangle";
@@ -48,6 +64,7 @@ nlohmann::json base_summary(const MappedOnBase& mapped, const BaseLift& lift, co
   s["removed_vertices"] = mapped.maps.removed_vertices;
   s["refused_removals"] = mapped.maps.refused_removals;
   s["unmapped_triangles"] = lift.unmapped_triangles();
+  s["base_offset_edges"] = base_offset(input.work, mapped.maps, domain);
   s["input_faces"] = input.original.num_faces();
   s["parameterized_faces"] = input.work.num_faces();
   s["seconds"] = seconds_since(start);
@@ -58,11 +75,11 @@ nlohmann::json base_summary(const MappedOnBase& mapped, const BaseLift& lift, co
 // so where input triangles are larger than the finest level's, nearby points of D lift through
 // different charts onto overlapping or gapped parts of a triangle, and the level's triangles
 // collapse or fold in 3D. Such an input is split 1:4 flat, which keeps its surface, until it
-// has at least twice the finest level's faces; `density` (per input vertex) is carried to the
+// has at least the finest level's faces; `density` (per input vertex) is carried to the
 // new vertices as the mean of their parents'.
 void refine_coarse_input(PreparedInput& input, long long finest_faces, Eigen::VectorXd& density) {
   int splits = 0;
-  for (long long faces = input.work.num_faces(); faces < 2 * finest_faces; faces *= 4) ++splits;
+  for (long long faces = input.work.num_faces(); faces < finest_faces; faces *= 4) ++splits;
   if (splits == 0) return;
   const SubdivisionConnectivity c = subdivide_connectivity(input.work.F, input.work.num_vertices(), splits);
   RowMatrixX3d V = input.work.V, w = RowMatrixX3d::Zero(density.size(), 3);
@@ -197,7 +214,7 @@ RemeshResult remesh_on_base_mesh(const TriMesh& input, const RemeshOptions& opti
   const BaseLift lift(prepared.work, domain, mapped.maps.location);
   result.input_locator = mapped.locator;
   result.domain = "base_mesh";
-  result.parameterization = base_summary(mapped, lift, prepared, start);
+  result.parameterization = base_summary(mapped, domain, lift, prepared, start);
   result.connectivity = subdivide_connectivity(mapped.maps.base.F, mapped.maps.base.num_vertices(), resolution.levels);
   const BaseContext context{domain,
                             lift,
