@@ -130,6 +130,31 @@ int star_flips(const BaseDomain& domain, const RowMatrixX3i& F, const VertexStar
   return flips;
 }
 
+// Vertex v to the first of at(step), at(step/2), … (positions in chart c; six tries) that adds
+// no flipped triangle to its star and, with a floor, keeps its smallest Q above
+// min(its value before, the floor). Charts disagree a little across K's edges, so a split can
+// leave a triangle flipped in its own chart: a move may keep such flips but never add one, and
+// smoothing undoes them. Returns whether v moved.
+template <class At>
+bool move_by_halving(const RowMatrixX3i& F, const VertexStars& stars, const BaseDomain& domain, const BaseLift& lift,
+                     const BaseSmoothingOptions& options, int c, int v, BaseLayout& layout, At&& at) {
+  const Eigen::Vector3d x = layout.X.row(v);
+  const double floor =
+      options.quality_floor > 0 ? std::min(star_quality(layout.X, F, stars, v, x), options.quality_floor) : 0.0;
+  const int flips = star_flips(domain, F, stars, layout, v, layout.points[v]);
+  double t = options.step;
+  for (int attempt = 0; attempt < 6; ++attempt, t *= 0.5) {
+    const std::optional<BasePoint> p = domain.from_chart(c, at(t));
+    if (!p || star_flips(domain, F, stars, layout, v, *p) > flips) continue;
+    const Eigen::Vector3d lifted = lift.lift(*p);
+    if (flips == 0 && options.quality_floor > 0 && star_quality(layout.X, F, stars, v, lifted) < floor) continue;
+    layout.points[v] = *p;
+    layout.X.row(v) = lifted.transpose();
+    return true;
+  }
+  return false;
+}
+
 // One vertex toward its target, by the largest of step, step/2, ... that keeps its star
 // unflipped and, with a floor, its smallest Q. Returns whether it moved.
 bool move_vertex(const RowMatrixX3i& F, const VertexStars& stars, const BaseDomain& domain, const BaseLift& lift,
@@ -145,24 +170,8 @@ bool move_vertex(const RowMatrixX3i& F, const VertexStars& stars, const BaseDoma
       chart_move = pull_back_by_star(domain, F, stars, layout, c, v, *normal, *move);
   if (!chart_move) return false;
   const Eigen::Vector2d start = domain.to_chart(c, layout.points[v]);
-  const Eigen::Vector3d x = layout.X.row(v);
-  const double floor =
-      options.quality_floor > 0 ? std::min(star_quality(layout.X, F, stars, v, x), options.quality_floor) : 0.0;
-  // Charts disagree a little across K's edges, so a split can leave a triangle flipped in its
-  // own chart: a move may keep such flips but never add one, and smoothing undoes them.
-  const int flips = star_flips(domain, F, stars, layout, v, layout.points[v]);
-  double t = options.step;
-  for (int attempt = 0; attempt < 6; ++attempt, t *= 0.5) {
-    const Eigen::Vector2d q = start + t * *chart_move;
-    const std::optional<BasePoint> p = domain.from_chart(c, q);
-    if (!p || star_flips(domain, F, stars, layout, v, *p) > flips) continue;
-    const Eigen::Vector3d lifted = lift.lift(*p);
-    if (flips == 0 && options.quality_floor > 0 && star_quality(layout.X, F, stars, v, lifted) < floor) continue;
-    layout.points[v] = *p;
-    layout.X.row(v) = lifted.transpose();
-    return true;
-  }
-  return false;
+  return move_by_halving(F, stars, domain, lift, options, c, v, layout,
+                         [&](double t) -> Eigen::Vector2d { return start + t * *chart_move; });
 }
 
 // Rim vertex v slid along the rim, between its rim neighbours a and b, toward the point that
@@ -187,20 +196,8 @@ bool slide_rim_vertex(const RowMatrixX3i& F, const VertexStars& stars, const Bas
   const double per_s_after = (x - layout.X.row(rim[1]).transpose()).norm() / (1 - s);
   if (!(per_s_before + per_s_after > 0)) return false;
   const double even = per_s_after / (per_s_before + per_s_after);
-  const double floor =
-      options.quality_floor > 0 ? std::min(star_quality(layout.X, F, stars, v, x), options.quality_floor) : 0.0;
-  const int flips = star_flips(domain, F, stars, layout, v, layout.points[v]);
-  double t = options.step;
-  for (int attempt = 0; attempt < 6; ++attempt, t *= 0.5) {
-    const std::optional<BasePoint> p = domain.from_chart(c, qa + (s + t * (even - s)) * chord);
-    if (!p || star_flips(domain, F, stars, layout, v, *p) > flips) continue;
-    const Eigen::Vector3d lifted = lift.lift(*p);
-    if (flips == 0 && options.quality_floor > 0 && star_quality(layout.X, F, stars, v, lifted) < floor) continue;
-    layout.points[v] = *p;
-    layout.X.row(v) = lifted.transpose();
-    return true;
-  }
-  return false;
+  return move_by_halving(F, stars, domain, lift, options, c, v, layout,
+                         [&](double t) -> Eigen::Vector2d { return qa + (s + t * (even - s)) * chord; });
 }
 
 // The wanted density under each vertex of the layout: even without a surface density.
