@@ -262,7 +262,7 @@ BaseLayout base_vertices_layout(const BaseDomain& domain, const BaseLift& lift) 
   return layout;
 }
 
-void split_on_base(const SubdivisionConnectivity& connectivity, int j, const BaseDomain& domain, const BaseLift& lift,
+bool split_on_base(const SubdivisionConnectivity& connectivity, int j, const BaseDomain& domain, const BaseLift& lift,
                    BaseLayout& layout) {
   const int previous = connectivity.vertex_count(j - 1), n = connectivity.vertex_count(j);
   layout.points.resize(n);
@@ -276,12 +276,11 @@ void split_on_base(const SubdivisionConnectivity& connectivity, int j, const Bas
     };
     const std::optional<BasePoint> mid = edge_midpoint(domain, layout.points[parents[0]], layout.points[parents[1]],
                                                        apex(parents[0], parents[1]), apex(parents[1], parents[0]));
-    if (!mid)
-      throw AlgorithmError("level " + std::to_string(j) + ": the edge " + std::to_string(parents[0]) + "-" +
-                           std::to_string(parents[1]) + " spans more than one chart of the base mesh");
+    if (!mid) return false;
     layout.points[v] = *mid;
     layout.X.row(v) = lift.lift(*mid).transpose();
   }
+  return true;
 }
 
 int smooth_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLift& lift, BaseLayout& layout,

@@ -31,9 +31,11 @@ BaseLayout base_vertices_layout(const BaseDomain& domain, const BaseLift& lift);
 /// Level j > 0 from level j − 1: each new vertex at the midpoint of its parents in a chart
 /// that holds both, lifted.
 /// \pre layout holds level j − 1 of `connectivity`.
-/// \throw AlgorithmError if two parents share no chart (the level is too coarse for K).
-void split_on_base(const SubdivisionConnectivity& connectivity, int j, const BaseDomain& domain, const BaseLift& lift,
-                   BaseLayout& layout);
+/// \return false, with `layout` partly split, if two parents share no chart: a relaxed sliver
+/// can stretch an edge across more than one star of K. The dyadic split never does, as each
+/// of its edges lies in one face of K.
+[[nodiscard]] bool split_on_base(const SubdivisionConnectivity& connectivity, int j, const BaseDomain& domain,
+                                 const BaseLift& lift, BaseLayout& layout);
 
 struct BaseSmoothingOptions {
   int iterations = 6;

@@ -126,8 +126,8 @@ struct LevelStart {
   BaseLayout dyadic;
 };
 
-// Level j laid out: the relaxed level before, split, untangled and relaxed, if that leaves no
-// flip; else the dyadic split relaxed, which starts with none: each of its triangles lies in
+// Level j laid out: the relaxed level before, split, untangled and relaxed, if every edge has a
+// chart and that leaves no flip; else the dyadic split relaxed, which starts with none: each of its triangles lies in
 // one face of K, where every chart is an affine image of the face. Charts disagree across K's
 // edges, so the split of a relaxed sliver can fold; the relaxation never adds a flip and mostly
 // undoes the folds it starts with.
@@ -145,12 +145,14 @@ LaidOutLevel lay_out_level(const BaseContext& ctx, const RemeshOptions& options,
     const int moves = full ? relax_level(ctx, options.relaxation, j, layout) : 0;
     return LaidOutLevel{std::move(layout), moves, false};
   };
-  split_on_base(ctx.connectivity, j, ctx.domain, ctx.lift, start.dyadic);
-  split_on_base(ctx.connectivity, j, ctx.domain, ctx.lift, start.relaxed);
-  untangle_on_base(F, ctx.domain, ctx.lift, start.relaxed);
-  LaidOutLevel level = relaxed(std::move(start.relaxed));
-  if (count_flipped_on_base(ctx.domain, F, level.layout.points) == 0) return level;
-  level = relaxed(start.dyadic);
+  if (!split_on_base(ctx.connectivity, j, ctx.domain, ctx.lift, start.dyadic))
+    throw AlgorithmError("level " + std::to_string(j) + ": the dyadic split left a face of the base mesh");
+  if (split_on_base(ctx.connectivity, j, ctx.domain, ctx.lift, start.relaxed)) {
+    untangle_on_base(F, ctx.domain, ctx.lift, start.relaxed);
+    LaidOutLevel level = relaxed(std::move(start.relaxed));
+    if (count_flipped_on_base(ctx.domain, F, level.layout.points) == 0) return level;
+  }
+  LaidOutLevel level = relaxed(start.dyadic);
   level.from_dyadic = true;
   return level;
 }

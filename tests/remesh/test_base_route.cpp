@@ -113,6 +113,42 @@ TEST(BaseLevels, FlipCountSeesReversedAndUnchartedTriangles) {
   EXPECT_EQ(count_flipped_on_base(domain, F, apart), 1);
 }
 
+// K as its own input, split once: each new vertex lifts to its parents' 3D midpoint, as every
+// face of K is flat. With one parent moved to a face that no chart of the other reaches, the
+// split reports the edge instead of placing a midpoint.
+TEST(BaseLevels, SplitPlacesMidpointsAndReportsAnEdgeWithNoChart) {
+  const TriMesh K = icosphere(0);
+  const BaseDomain domain(K);
+  std::vector<BasePoint> location;
+  for (int v = 0; v < K.num_vertices(); ++v) location.push_back(domain.vertex_point(v));
+  const BaseLift lift(K, domain, location);
+  const SubdivisionConnectivity c = subdivide_connectivity(K.F, K.num_vertices(), 1);
+  const BaseLayout start = base_vertices_layout(domain, lift);
+  BaseLayout layout = start;
+  ASSERT_TRUE(split_on_base(c, 1, domain, lift, layout));
+  ASSERT_EQ(static_cast<int>(layout.points.size()), c.vertex_count(1));
+  for (int v = c.vertex_count(0); v < c.vertex_count(1); ++v) {
+    const Eigen::Vector2i p = c.parents(v);
+    const Eigen::RowVector3d mid = 0.5 * (K.V.row(p[0]) + K.V.row(p[1]));
+    EXPECT_LT((layout.X.row(v) - mid).norm(), 1e-9) << "vertex " << v;
+  }
+  // A face with no corner in the closed star of b, the second parent of the first new vertex.
+  const Eigen::Vector2i p = c.parents(c.vertex_count(0));
+  const auto has = [&](int f, int w) { return K.F(f, 0) == w || K.F(f, 1) == w || K.F(f, 2) == w; };
+  const auto near_b = [&](int w) {
+    for (int f = 0; f < K.num_faces(); ++f)
+      if (has(f, p[1]) && has(f, w)) return true;
+    return false;
+  };
+  int far_face = -1;
+  for (int f = 0; f < K.num_faces() && far_face < 0; ++f)
+    if (!near_b(K.F(f, 0)) && !near_b(K.F(f, 1)) && !near_b(K.F(f, 2))) far_face = f;
+  ASSERT_GE(far_face, 0);
+  BaseLayout moved = start;
+  moved.points[p[0]] = BasePoint{far_face, Eigen::Vector3d::Constant(1.0 / 3)};
+  EXPECT_FALSE(split_on_base(c, 1, domain, lift, moved));
+}
+
 // A flat disk whose rim wobbles, radius 1 + 0.25 sin 7θ, as a polar grid: `rings` rings of
 // `around` vertices around a centre.
 TriMesh wavy_disk(int rings, int around) {
