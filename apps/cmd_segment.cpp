@@ -237,7 +237,9 @@ struct SnakeArgs {
                "External force: auto (profiles if the model has an appearance, unless they learned a clean step), "
                "profile, edge")
             ->capture_default_str();
-    cmd->add_option("--max-iterations", max_iterations, "Iterations per level at most (default 40)");
+    cmd->add_option("--max-iterations", max_iterations,
+                    "Iterations per level at most (default 40; 0 writes the placed model)")
+        ->check(CLI::Range(0, 100000));
   }
   SegmentOptions options() const {
     SegmentOptions o = config.empty() ? SegmentOptions{} : read_options_file<SegmentOptions>(config);

@@ -469,3 +469,12 @@ TEST(CommandLine, NonFiniteNumbersAreUsageErrors) {
   }
   EXPECT_TRUE(fs::is_empty(out));
 }
+
+TEST(CommandLine, ANegativeIterationCountIsAUsageError) {
+  // Unset, the count is the options' own; 0 writes the placed model; below that is a mistake.
+  for (const std::string& count : {"-3", "-1"}) {
+    const auto r = run_mrsnake("segment --model m --image i.nii.gz -o o --max-iterations " + count);
+    EXPECT_EQ(r.exit_code, 2) << count << "\n" << r.output;
+    EXPECT_NE(r.output.find("--max-iterations"), std::string::npos) << count << "\n" << r.output;
+  }
+}
