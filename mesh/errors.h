@@ -43,6 +43,12 @@ class InputError : public Error {
   using Error::Error;
 };
 
+/// An option (a flag, or a key of an options file) has a value outside its range.
+class OptionsError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 /// A mesh has a topology the algorithm does not accept (genus, boundaries, non-manifold...).
 class TopologyError : public Error {
  public:

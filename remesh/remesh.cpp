@@ -11,6 +11,7 @@
 
 #include "mesh/distance.h"
 #include "mesh/errors.h"
+#include "mesh/option_checks.h"
 #include "mesh/parallel.h"
 #include "mesh/quality.h"
 #include "remesh/base_mesh.h"
@@ -83,32 +84,32 @@ SizingFields sizing_fields(const TriMesh& surface, const SizingOptions& sizing, 
   return s;
 }
 
-// \throw std::invalid_argument naming the first option out of range (by its JSON key path).
+// \throw OptionsError naming the first option out of range (by its JSON key path).
 void check_options(const RemeshOptions& o) {
-  if (o.levels < 0 || o.levels > 12) throw std::invalid_argument("levels must be in [0, 12]");
-  if (o.levels == 0 && o.target_faces < 16) throw std::invalid_argument("target_faces must be at least 16");
-  if (o.relaxation.lloyd_iterations < 0) throw std::invalid_argument("relaxation.lloyd_iterations must be >= 0");
-  if (o.relaxation.shape_iterations < 0) throw std::invalid_argument("relaxation.shape_iterations must be >= 0");
-  if (!(o.base.density_exponent >= 0 && o.base.density_exponent <= 4))
-    throw std::invalid_argument("base.density_exponent must be in [0, 4]");
-  if (!(o.base.max_bend >= 0)) throw std::invalid_argument("base.max_bend must be >= 0");
-  if (o.base.density_smoothing < -1) throw std::invalid_argument("base.density_smoothing must be >= -1");
-  if (o.snap.max_snaps < 0) throw std::invalid_argument("snap.max_snaps must be >= 0");
-  if (o.fit.rounds < 0) throw std::invalid_argument("fit.rounds must be >= 0");
-  if (o.relaxation.surface_iterations < 0) throw std::invalid_argument("relaxation.surface_iterations must be >= 0");
-  if (!(o.relaxation.surface_quality_floor >= 0 && o.relaxation.surface_quality_floor <= 1))
-    throw std::invalid_argument("relaxation.surface_quality_floor must be in [0, 1]");
-  if (!(o.sizing.curvature_exponent > 0 && o.sizing.curvature_exponent <= 4))
-    throw std::invalid_argument("sizing.curvature_exponent must be in (0, 4]");
-  if (o.repair.sweeps < 0) throw std::invalid_argument("repair.sweeps must be >= 0");
-  if (!(o.repair.threshold > 0 && o.repair.threshold <= 1))
-    throw std::invalid_argument("repair.threshold must be in (0, 1]");
-  if (!(o.repair.error_tolerance >= 0)) throw std::invalid_argument("repair.error_tolerance must be >= 0");
-  if (o.base.rim_min_triangles < 1 || o.base.rim_min_triangles > 3)
-    throw std::invalid_argument("base.rim_min_triangles must be in [1, 3]");
-  if (o.base_vertices < 6) throw std::invalid_argument("base_vertices must be at least 6");
-  if (!(o.sizing.density_exponent >= 0 && o.sizing.density_exponent <= 8))
-    throw std::invalid_argument("sizing.density_exponent must be in [0, 8]");
+  require_in("levels", o.levels, 0, 12);
+  if (o.levels == 0) require_at_least("target_faces", o.target_faces, 16);
+  require_at_least("base_vertices", o.base_vertices, 6);
+  require_at_least("relaxation.lloyd_iterations", o.relaxation.lloyd_iterations, 0);
+  require_at_least("relaxation.shape_iterations", o.relaxation.shape_iterations, 0);
+  require_at_least("relaxation.surface_iterations", o.relaxation.surface_iterations, 0);
+  require_in("relaxation.surface_quality_floor", o.relaxation.surface_quality_floor, 0.0, 1.0);
+  require_in("sizing.density_exponent", o.sizing.density_exponent, 0.0, 8.0);
+  require_in("sizing.curvature_exponent", o.sizing.curvature_exponent, 1e-9, 4.0);
+  require_in("base.density_exponent", o.base.density_exponent, 0.0, 4.0);
+  require_at_least("base.max_bend", o.base.max_bend, 0.0);
+  require_at_least("base.density_smoothing", o.base.density_smoothing, -1);
+  require_in("base.rim_min_triangles", o.base.rim_min_triangles, 1, 3);
+  require_at_least("snap.max_snaps", o.snap.max_snaps, 0);
+  require_at_least("fit.rounds", o.fit.rounds, 0);
+  require_at_least("repair.sweeps", o.repair.sweeps, 0);
+  require_in("repair.threshold", o.repair.threshold, 1e-9, 1.0);
+  require_at_least("repair.error_tolerance", o.repair.error_tolerance, 0.0);
+  // The paper's exact method relaxes new vertices in one domain chart; the base mesh's levels
+  // have no such mode.
+  if (o.domain == ParameterDomain::base_mesh && o.relax == RelaxMode::new_vertices_only)
+    throw OptionsError(
+        "relax new_vertices_only (--strict, the paper's exact method) runs on the sphere domain only; "
+        "drop it or the domain base_mesh");
 }
 
 // The parameterization of the prepared input, and the original's closest-point tree (for the

@@ -193,7 +193,8 @@ struct RemeshResult {
 ///        names what was found).
 /// \throw AlgorithmError if the parameterization fails or is too distorted, or a level cannot
 ///        be built without flipped triangles; nothing partial is returned.
-/// \throw std::invalid_argument on bad options.
+/// \throw OptionsError if an option is out of its range, or relax is new_vertices_only on the
+///        base_mesh domain.
 RemeshResult remesh(const TriMesh& input, const RemeshOptions& options);
 
 /// The report.json document of a result: options, parameterization and every level's stats.

@@ -146,6 +146,23 @@ TEST_F(RemeshConfigCli, ConfigFileChangesAFieldAndTheReportShowsIt) {
   EXPECT_NE(bad.exit_code, 0);
   EXPECT_NE(bad.output.find("relaxation.lloyd"), std::string::npos) << bad.output;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "bad"));
+  // A value out of range is refused the same way, naming its key and its range.
+  write_json(dir_ / "deep.json", {{"levels", 20}});
+  const auto deep = test::run_mrsnake("-q remesh " + input_ + " -o " + (dir_ / "deep").string() + " --config " +
+                                      (dir_ / "deep.json").string());
+  EXPECT_EQ(deep.exit_code, 3) << deep.output;
+  EXPECT_NE(deep.output.find("levels is 20; it must be in [0, 12]"), std::string::npos) << deep.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "deep"));
+}
+
+TEST(RemeshOptionsCheck, ThePapersExactMethodIsRefusedOnTheBaseMeshDomain) {
+  RemeshOptions o;
+  o.domain = ParameterDomain::base_mesh;
+  o.relax = RelaxMode::new_vertices_only;
+  EXPECT_THROW(remesh(ellipsoid(2), o), OptionsError);
+  o.domain = ParameterDomain::sphere;
+  o.relaxation.surface_quality_floor = 1.5;
+  EXPECT_THROW(remesh(ellipsoid(2), o), OptionsError);
 }
 
 TEST_F(RemeshConfigCli, ReportOptionsRepeatTheRunExactly) {
