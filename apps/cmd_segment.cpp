@@ -248,6 +248,7 @@ struct SnakeArgs {
       o.registration.itk.metric = parse_registration_metric(register_metric);
     if (config.empty() || force_flag->count() > 0) o.force = parse_force_mode(force);
     if (max_iterations >= 0) o.snake.max_iterations = max_iterations;
+    check_options(o);  // before the model and the images are read
     return o;
   }
 };

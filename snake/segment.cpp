@@ -4,10 +4,13 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <string>
+#include <utility>
 
 #include "mesh/stage_clock.h"
 #include "mesh/distance.h"
 #include "mesh/errors.h"
+#include "mesh/option_checks.h"
 #include "snake/image_pyramid.h"
 #include "snake/level_search.h"
 #include "snake/pose.h"
@@ -247,11 +250,80 @@ LevelOutcome deform_level(int j, RowMatrixX3d& V, const SnakeModel& model, const
   return out;
 }
 
+void check_snake_options(const std::string& at, const SnakeOptions& o) {
+  for (const auto& [key, weight] : {std::pair<const char*, double>{"membrane_weight", o.membrane_weight},
+                                    {"thin_plate_weight", o.thin_plate_weight},
+                                    {"prior_weight", o.prior_weight},
+                                    {"tangential_weight", o.tangential_weight},
+                                    {"tolerance", o.tolerance}})
+    require_at_least(at + key, weight, 0.0);
+  require_in(at + "external_weight", o.external_weight, 0.0, 1.0);
+  require_positive(at + "time_step", o.time_step);
+  require_positive(at + "max_step_fraction", o.max_step_fraction);
+  for (const auto& [key, count] : {std::pair<const char*, int>{"offset_median", o.offset_median},
+                                   {"offset_smoothing", o.offset_smoothing},
+                                   {"max_iterations", o.max_iterations},
+                                   {"min_iterations", o.min_iterations},
+                                   {"patience", o.patience}})
+    require_at_least(at + key, count, 0);
+}
+
+void check_search_options(const SegmentOptions& o) {
+  for (const auto& [key, length] : {std::pair<const char*, double>{"range_edge_fraction", o.range_edge_fraction},
+                                    {"coarse_range_edge_fraction", o.coarse_range_edge_fraction},
+                                    {"step_voxels", o.step_voxels},
+                                    {"profile_step_fraction", o.profile_step_fraction},
+                                    {"window_voxels", o.window_voxels},
+                                    {"edge_per_voxel", o.edge_per_voxel},
+                                    {"fit_tolerance_voxels", o.fit_tolerance_voxels},
+                                    {"cost_ring_full_weight_cost", o.cost_ring_full_weight_cost},
+                                    {"fine.profile_step_fraction", o.fine.profile_step_fraction}})
+    require_positive(key, length);
+  for (const auto& [key, bound] : {std::pair<const char*, double>{"min_range_voxels", o.min_range_voxels},
+                                   {"fit_min_range_voxels", o.fit_min_range_voxels},
+                                   {"max_range_voxels", o.max_range_voxels},
+                                   {"max_edge_cost", o.max_edge_cost},
+                                   {"max_profile_cost", o.max_profile_cost},
+                                   {"profile_distance_penalty", o.profile_distance_penalty},
+                                   {"edge_distance_penalty", o.edge_distance_penalty},
+                                   {"search_min_gain", o.search_min_gain},
+                                   {"clean_step_max_residual", o.clean_step_max_residual},
+                                   {"min_edge_voxels", o.min_edge_voxels},
+                                   {"fine.min_edge_voxels", o.fine.min_edge_voxels},
+                                   {"fine.offset_smoothing_voxels", o.fine.offset_smoothing_voxels}})
+    require_at_least(key, bound, 0.0);
+  require_in("cost_ring_weight", o.cost_ring_weight, 0.0, 1.0);
+}
+
+void check_placement_options(const SegmentOptions& o) {
+  for (const auto& [key, count] : {std::pair<const char*, int>{"fit.iterations", o.fit.iterations},
+                                   {"fit.patience", o.fit.patience},
+                                   {"fit_patience_after_registration", o.fit_patience_after_registration},
+                                   {"fit_level", o.fit_level},
+                                   {"fine.min_iterations", o.fine.min_iterations},
+                                   {"fine.patience", o.fine.patience}})
+    require_at_least(key, count, 0);
+  require_in("fit.trim_fraction", o.fit.trim_fraction, 0.0, 0.9);
+  require_at_least("moments.roi_margin", o.moments.roi_margin, 0.0);
+  require_at_least("moments.min_axis_separation", o.moments.min_axis_separation, 0.0);
+  require_in("moments.max_rotation_deg", o.moments.max_rotation_deg, 0.0, 180.0);
+  require_positive("registration.min_scale", o.registration.min_scale);
+  require_at_least("registration.max_scale", o.registration.max_scale, o.registration.min_scale);
+  require_at_least("intensity_samples", o.intensity_samples, std::size_t{1});
+}
+
 }  // namespace
+
+void check_options(const SegmentOptions& options) {
+  check_snake_options("snake.", options.snake);
+  check_search_options(options);
+  check_placement_options(options);
+}
 
 SegmentResult segment(const Volume& image, const SnakeModel& model, const SegmentOptions& options,
                       const ProgressFn& progress) {
   const auto t_start = Clock::now();
+  check_options(options);
   check_model(model, options.force);
   const int L = model.finest_level();
   const ForceChoice force = choose_force(model, options.force, options.clean_step_max_residual);

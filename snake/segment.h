@@ -248,10 +248,16 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(
     cost_ring_weight, cost_ring_full_weight_cost, intensity_samples, count_self_intersections, undo_self_intersections,
     min_edge_voxels, fine)
 
+/// Refuses options out of their range, by their options-file keys ("snake.max_iterations"):
+/// segment() and the commands call it before any work.
+/// \throw OptionsError naming the first such option.
+void check_options(const SegmentOptions& options);
+
 /// Segments `image` (any spacing and direction; not modified) with the model.
 /// \throw InputError if the model has no levels or its appearance does not match it, or if
 ///        options ask for --init register without a reference image in the model.
 /// \throw AlgorithmError if the initialization finds nothing to align to.
+/// \throw OptionsError if an option is out of its range (check_options).
 SegmentResult segment(const Volume& image, const SnakeModel& model, const SegmentOptions& options = {},
                       const ProgressFn& progress = {});
 

@@ -33,6 +33,35 @@ TEST(SegmentOptionsJson, TheDefaultsRoundTrip) {
   EXPECT_EQ(nlohmann::json(options_from_json<SegmentOptions>(nlohmann::json::object())), written);
 }
 
+TEST(SegmentOptionsCheck, TheDefaultsPassAndAValueOutOfRangeIsRefusedByItsKey) {
+  EXPECT_NO_THROW(check_options(SegmentOptions{}));
+  struct Case {
+    const char* key;
+    void (*spoil)(SegmentOptions&);
+  };
+  const Case cases[] = {
+      {"snake.max_iterations is -1", [](SegmentOptions& o) { o.snake.max_iterations = -1; }},
+      {"snake.time_step is 0", [](SegmentOptions& o) { o.snake.time_step = 0; }},
+      {"snake.external_weight is 2", [](SegmentOptions& o) { o.snake.external_weight = 2; }},
+      {"step_voxels is nan", [](SegmentOptions& o) { o.step_voxels = std::nan(""); }},
+      {"fit_level is -3", [](SegmentOptions& o) { o.fit_level = -3; }},
+      {"fit.trim_fraction is 1", [](SegmentOptions& o) { o.fit.trim_fraction = 1; }},
+      {"fine.profile_step_fraction is -0.5", [](SegmentOptions& o) { o.fine.profile_step_fraction = -0.5; }},
+      {"registration.max_scale is 0.4", [](SegmentOptions& o) { o.registration.max_scale = 0.4; }},
+      {"intensity_samples is 0", [](SegmentOptions& o) { o.intensity_samples = 0; }},
+  };
+  for (const Case& c : cases) {
+    SegmentOptions o;
+    c.spoil(o);
+    try {
+      check_options(o);
+      ADD_FAILURE() << c.key << ": accepted";
+    } catch (const OptionsError& e) {
+      EXPECT_NE(std::string(e.what()).find(c.key), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(SegmentOptionsJson, ChangedValuesRoundTripExactly) {
   SegmentOptions o;
   o.init = InitMode::registration_and_fit;
@@ -144,6 +173,12 @@ TEST(SegmentCommand, ConfigFromAReportsOptionsReproducesTheSurface) {
   EXPECT_EQ(bad.exit_code, 3) << bad.output;
   EXPECT_NE(bad.output.find("snake.max_iteration"), std::string::npos) << bad.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "bad"));
+  // A value out of range (a negative level names no level of the mesh): the same, before any work.
+  std::ofstream(dir / "range.json") << R"({"fit_level": -3})";
+  const auto range = mrsnake::test::run_mrsnake(segment + " -o " + d + "/range --config " + d + "/range.json");
+  EXPECT_EQ(range.exit_code, 3) << range.output;
+  EXPECT_NE(range.output.find("fit_level is -3"), std::string::npos) << range.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "range"));
   std::filesystem::remove_all(dir);
 }
 
