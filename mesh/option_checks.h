@@ -11,6 +11,11 @@
 
 namespace mrsnake {
 
+/// \throw OptionsError "the option KEY must be RANGE" unless ok.
+inline void require(bool ok, const std::string& key, const std::string& range) {
+  if (!ok) throw OptionsError("the option " + key + " must be " + range);
+}
+
 /// \throw OptionsError naming `key` unless lo <= value <= hi (a NaN is outside every range).
 template <class T>
 void require_in(const std::string& key, T value, T lo, T hi) {

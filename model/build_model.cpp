@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mesh/label_repair.h"
+#include "mesh/option_checks.h"
 #include "mesh/stage_clock.h"
 #include "mesh/quality.h"
 #include "model/build_model_json.h"
@@ -152,10 +153,6 @@ RemeshResult remesh_unrelaxed(const BuiltModel& built) {
   return remesh(built.surface.mesh, plain);
 }
 
-void require(bool ok, const char* key, const char* range) {
-  if (!ok) throw InputError(std::string("the option ") + key + " must be " + range);
-}
-
 }  // namespace
 
 void validate(const BuildModelOptions& o) {
@@ -169,6 +166,11 @@ void validate(const BuildModelOptions& o) {
   require(o.faces == 0 || o.levels == 0, "faces", "0 when levels is given");
   require(std::isfinite(o.reference_margin_mm) && o.reference_margin_mm <= 1000, "reference_margin_mm",
           "at most 1000 (mm; negative = derived)");
+  // The model's resolution is the top-level faces or levels: remesh's own would be overwritten.
+  const RemeshOptions preset = model_remesh_preset();
+  require(o.remesh.levels == preset.levels, "remesh.levels", "left out (give the top-level levels)");
+  require(o.remesh.target_faces == preset.target_faces, "remesh.target_faces",
+          "left out (give the top-level faces, or --faces)");
 }
 
 std::string describe_poor_fit(const LabelFit& fit) {

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mesh/errors.h"
 #include "model/build_model.h"
 #include "model/snake_adapter.h"
 #include "snake/reference_image.h"
@@ -161,4 +162,27 @@ TEST(BuildModel, ThePresetKeepsTheVerticesOnTheReferenceSurface) {
   EXPECT_EQ(preset.fit.rounds, 0);
   EXPECT_EQ(BuildModelOptions{}.remesh.fit.rounds, 0);
   EXPECT_GT(preset.sizing.curvature_weight, RemeshOptions{}.sizing.curvature_weight);
+}
+
+TEST(BuildModel, OptionsOutOfRangeOrOverwrittenAreRefusedBeforeAnyWork) {
+  // The resolution is the top-level faces or levels; remesh's own keys would be overwritten.
+  const Volume labels = ellipsoid_labels();
+  BuildModelOptions o = small_model(3);
+  o.remesh.target_faces = 5000;
+  EXPECT_THROW(build_model(labels, nullptr, o), OptionsError);
+  o = small_model(3);
+  o.remesh.levels = 2;
+  EXPECT_THROW(build_model(labels, nullptr, o), OptionsError);
+  // The remesh options' own ranges hold too.
+  o = small_model(3);
+  o.remesh.relaxation.lloyd_iterations = -1;
+  EXPECT_THROW(build_model(labels, nullptr, o), OptionsError);
+  o = small_model(3);
+  o.surface.close_tunnels = 40;
+  try {
+    build_model(labels, nullptr, o);
+    ADD_FAILURE() << "accepted";
+  } catch (const OptionsError& e) {
+    EXPECT_NE(std::string(e.what()).find("surface.close_tunnels"), std::string::npos) << e.what();
+  }
 }
