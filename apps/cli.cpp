@@ -35,9 +35,12 @@ void add_sphere_map_option(CLI::App& command, SphereMap& map) {
               std::to_string(ParameterizationOptions{}.halves_from_faces) +
               " faces, punctured below, hierarchical where those fail), 'halves' (cut in two disks across a "
               "principal plane, one solve per core), 'punctured' (one vertex removed, one solve) or 'hierarchical' "
-              "(coarse to fine from a tetrahedron: long protrusions keep their area)")
+              "(coarse to fine from a tetrahedron: long protrusions keep their area); the options file's names "
+              "'automatic' and 'two_halves' are taken too")
       ->transform(CLI::CheckedTransformer(std::map<std::string, SphereMap>{{"auto", SphereMap::automatic},
+                                                                           {"automatic", SphereMap::automatic},
                                                                            {"halves", SphereMap::two_halves},
+                                                                           {"two_halves", SphereMap::two_halves},
                                                                            {"punctured", SphereMap::punctured},
                                                                            {"hierarchical", SphereMap::hierarchical}}))
       ->option_text("auto|halves|punctured|hierarchical");

@@ -134,6 +134,9 @@ TEST_F(RemeshConfigCli, ConfigFileChangesAFieldAndTheReportShowsIt) {
   EXPECT_EQ(overridden["options"]["fit"]["rounds"], 2);
   EXPECT_EQ(overridden["options"]["relax"], "new_vertices_only");
   EXPECT_EQ(overridden["options"]["levels"], 2);
+  // The options file's names of the sphere map are the flag's too.
+  EXPECT_EQ(read_json(run("halves", "--faces 512 --sphere-map two_halves") / "report.json")["options"]["sphere_map"],
+            "two_halves");
   const nlohmann::json by_faces =
       read_json(run("c", "--config " + (dir_ / "fit.json").string() + " --faces 512") / "report.json");
   EXPECT_EQ(by_faces["options"]["levels"], 0);
