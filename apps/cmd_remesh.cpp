@@ -91,6 +91,7 @@ void add_remesh_command(CLI::App& app) {
     if (sphere_map->count() > 0) options.sphere_map = args->options.sphere_map;
     if (args->no_relax) options.relax = RelaxMode::none;
     if (args->strict) options.relax = RelaxMode::new_vertices_only;
+    check_options(options);  // before the mesh is read
     const TriMesh input = read_mesh(args->mesh);
     if (!global_options().quiet) options.progress = terminal_progress();
     const RemeshResult result = remesh(input, options);

@@ -238,8 +238,9 @@ struct SnakeArgs {
                "profile, edge")
             ->capture_default_str();
     cmd->add_option("--max-iterations", max_iterations,
-                    "Iterations per level at most (default 40; 0 writes the placed model)")
-        ->check(CLI::Range(0, 100000));
+                    "Iterations per level at most (default " + std::to_string(SnakeOptions{}.max_iterations) +
+                        "; 0 writes the placed model)")
+        ->check(CLI::Range(0, kMaxSnakeIterations));
   }
   SegmentOptions options() const {
     SegmentOptions o = config.empty() ? SegmentOptions{} : read_options_file<SegmentOptions>(config);

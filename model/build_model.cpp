@@ -171,6 +171,7 @@ void validate(const BuildModelOptions& o) {
   require(o.remesh.levels == preset.levels, "remesh.levels", "left out (give the top-level levels)");
   require(o.remesh.target_faces == preset.target_faces, "remesh.target_faces",
           "left out (give the top-level faces, or --faces)");
+  check_options(o.remesh, "remesh.");
 }
 
 std::string describe_poor_fit(const LabelFit& fit) {

@@ -67,7 +67,7 @@ struct BuildModelOptions {
   ModelReportOptions report;
 };
 
-/// \throw InputError naming the JSON key of the first option out of its range.
+/// \throw OptionsError naming the JSON key of the first option out of its range.
 void validate(const BuildModelOptions& options);
 
 /// A model and what its stages measured on the way.
@@ -114,8 +114,8 @@ std::string describe_poor_fit(const LabelFit& fit);
 
 /// A model of one label of `labels`, with the appearance of `image` when it is given.
 /// \pre image, when given, lies in the physical space of labels.
-/// \throw InputError if the options are out of range (validate), the label is absent or the image constant;
-/// LabelGenusError; the
+/// \throw OptionsError if the options are out of range (validate).
+/// \throw InputError if the label is absent or the image constant; LabelGenusError; the
 ///        errors of remesh(); PoorFitError unless options.allow_poor_fit.
 BuiltModel build_model(const Volume& labels, const Volume* image, const BuildModelOptions& options = {},
                        const ProgressFn& progress = {});

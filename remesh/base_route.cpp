@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -126,17 +127,17 @@ struct LevelStart {
   BaseLayout dyadic;
 };
 
-// Level j laid out: the relaxed level before, split, untangled and relaxed, if every edge has a
-// chart and that leaves no flip; else the dyadic split relaxed, which starts with none: each of its triangles lies in
-// one face of K, where every chart is an affine image of the face. Charts disagree across K's
-// edges, so the split of a relaxed sliver can fold; the relaxation never adds a flip and mostly
-// undoes the folds it starts with.
 struct LaidOutLevel {
   BaseLayout layout;
   int moves = 0;
   bool from_dyadic = false;
 };
 
+// Level j laid out: the relaxed level before, split, untangled and relaxed, if every edge has
+// a chart and that leaves no flip; else the dyadic split relaxed, which starts with none: each
+// of its triangles lies in one face of K, where every chart is an affine image of the face.
+// Charts disagree across K's edges, so the split of a relaxed sliver can fold; the relaxation
+// never adds a flip and mostly undoes the folds it starts with.
 LaidOutLevel lay_out_level(const BaseContext& ctx, const RemeshOptions& options, int j, LevelStart& start) {
   if (j == 0) return {start.relaxed, 0, true};  // K: its vertices where MAPS kept them
   const RowMatrixX3i& F = ctx.connectivity.faces[j];
@@ -146,7 +147,7 @@ LaidOutLevel lay_out_level(const BaseContext& ctx, const RemeshOptions& options,
     return LaidOutLevel{std::move(layout), moves, false};
   };
   if (!split_on_base(ctx.connectivity, j, ctx.domain, ctx.lift, start.dyadic))
-    throw AlgorithmError("level " + std::to_string(j) + ": the dyadic split left a face of the base mesh");
+    throw std::logic_error("level " + std::to_string(j) + ": the dyadic split has an edge that no chart holds");
   if (split_on_base(ctx.connectivity, j, ctx.domain, ctx.lift, start.relaxed)) {
     untangle_on_base(F, ctx.domain, ctx.lift, start.relaxed);
     LaidOutLevel level = relaxed(std::move(start.relaxed));

@@ -84,33 +84,57 @@ SizingFields sizing_fields(const TriMesh& surface, const SizingOptions& sizing, 
   return s;
 }
 
-// \throw OptionsError naming the first option out of range (by its JSON key path).
-void check_options(const RemeshOptions& o) {
-  require_in("levels", o.levels, 0, 12);
-  if (o.levels == 0) require_at_least("target_faces", o.target_faces, 16);
-  require_at_least("base_vertices", o.base_vertices, 6);
-  require_at_least("relaxation.lloyd_iterations", o.relaxation.lloyd_iterations, 0);
-  require_at_least("relaxation.shape_iterations", o.relaxation.shape_iterations, 0);
-  require_at_least("relaxation.surface_iterations", o.relaxation.surface_iterations, 0);
-  require_in("relaxation.surface_quality_floor", o.relaxation.surface_quality_floor, 0.0, 1.0);
-  require_in("sizing.density_exponent", o.sizing.density_exponent, 0.0, 8.0);
-  require_in("sizing.curvature_exponent", o.sizing.curvature_exponent, 1e-9, 4.0);
-  require_in("base.density_exponent", o.base.density_exponent, 0.0, 4.0);
-  require_at_least("base.max_bend", o.base.max_bend, 0.0);
-  require_at_least("base.density_smoothing", o.base.density_smoothing, -1);
-  require_in("base.rim_min_triangles", o.base.rim_min_triangles, 1, 3);
-  require_at_least("snap.max_snaps", o.snap.max_snaps, 0);
-  require_at_least("fit.rounds", o.fit.rounds, 0);
-  require_at_least("repair.sweeps", o.repair.sweeps, 0);
-  require_in("repair.threshold", o.repair.threshold, 1e-9, 1.0);
-  require_at_least("repair.error_tolerance", o.repair.error_tolerance, 0.0);
+void check_resolution_and_relaxation(const RemeshOptions& o, const std::string& at) {
+  require_in(at + "levels", o.levels, 0, 12);
+  if (o.levels == 0) require_at_least(at + "target_faces", o.target_faces, 16);
+  require_at_least(at + "base_vertices", o.base_vertices, 6);
+  require_at_least(at + "simplify.above_faces", o.simplify.above_faces, 0);
+  require_at_least(at + "relaxation.lloyd_iterations", o.relaxation.lloyd_iterations, 0);
+  require_at_least(at + "relaxation.shape_iterations", o.relaxation.shape_iterations, 0);
+  require_at_least(at + "relaxation.surface_iterations", o.relaxation.surface_iterations, 0);
+  require_in(at + "relaxation.surface_quality_floor", o.relaxation.surface_quality_floor, 0.0, 1.0);
   // The paper's exact method relaxes new vertices in one domain chart; the base mesh's levels
   // have no such mode.
   if (o.domain == ParameterDomain::base_mesh && o.relax == RelaxMode::new_vertices_only)
-    throw OptionsError(
-        "relax new_vertices_only (--strict, the paper's exact method) runs on the sphere domain only; "
-        "drop it or the domain base_mesh");
+    throw OptionsError("the option " + at +
+                       "relax new_vertices_only (--strict, the paper's exact method) runs on "
+                       "the sphere domain only; drop it or the domain base_mesh");
 }
+
+void check_sizing_and_finish(const RemeshOptions& o, const std::string& at) {
+  require_at_least(at + "sizing.curvature_weight", o.sizing.curvature_weight, 0.0);
+  require_in(at + "sizing.density_exponent", o.sizing.density_exponent, 0.0, 8.0);
+  require_positive(at + "sizing.curvature_exponent", o.sizing.curvature_exponent);
+  require_in(at + "sizing.curvature_exponent", o.sizing.curvature_exponent, 0.0, 4.0);
+  require_in(at + "base.density_exponent", o.base.density_exponent, 0.0, 4.0);
+  require_at_least(at + "base.max_bend", o.base.max_bend, 0.0);
+  require_at_least(at + "base.density_smoothing", o.base.density_smoothing, -1);
+  require_in(at + "base.rim_min_triangles", o.base.rim_min_triangles, 1, 3);
+  require_at_least(at + "snap.max_snaps", o.snap.max_snaps, 0);
+  require_at_least(at + "snap.min_distance", o.snap.min_distance, 0.0);
+  require_at_least(at + "snap.min_gain", o.snap.min_gain, 0.0);
+  require_in(at + "snap.min_quality", o.snap.min_quality, 0.0, 1.0);
+  require_in(at + "snap.min_share_of_largest", o.snap.min_share_of_largest, 0.0, 1.0);
+  require_in(at + "snap.min_angle_deg", o.snap.min_angle_deg, 0.0, 60.0);
+  require_at_least(at + "fit.rounds", o.fit.rounds, 0);
+  require_positive(at + "fit.regularization", o.fit.regularization);
+  require_at_least(at + "fit.max_offset", o.fit.max_offset, 0.0);
+  require_positive(at + "fit.max_sample_distance", o.fit.max_sample_distance);
+  require_in(at + "fit.quality_floor", o.fit.quality_floor, 0.0, 1.0);
+  require_at_least(at + "repair.sweeps", o.repair.sweeps, 0);
+  require_positive(at + "repair.threshold", o.repair.threshold);
+  require_in(at + "repair.threshold", o.repair.threshold, 0.0, 1.0);
+  require_at_least(at + "repair.error_tolerance", o.repair.error_tolerance, 0.0);
+}
+
+}  // namespace
+
+void check_options(const RemeshOptions& options, const std::string& at) {
+  check_resolution_and_relaxation(options, at);
+  check_sizing_and_finish(options, at);
+}
+
+namespace {
 
 // The parameterization of the prepared input, and the original's closest-point tree (for the
 // reprojection, the fit and the report's distances) built on the other core meanwhile.

@@ -187,14 +187,20 @@ struct RemeshResult {
   TriMesh mesh(int level) const { return {levels[level].positions, connectivity.faces[level]}; }
 };
 
+/// Refuses options out of their range, by their options-file keys, each prefixed with `at`
+/// ("remesh." where the options sit inside another command's): remesh() and the commands call
+/// it before any work.
+/// \throw OptionsError naming the first such option, or relax new_vertices_only on the
+///        base_mesh domain, which has no such mode.
+void check_options(const RemeshOptions& options, const std::string& at = "");
+
 /// Remeshes a disk or closed genus-0 surface into a nested semi-regular hierarchy.
 /// \pre input has at least one face; options.levels >= 0, options.target_faces > 0.
 /// \throw TopologyError if the input is not a disk or a closed genus-0 surface (the message
 ///        names what was found).
 /// \throw AlgorithmError if the parameterization fails or is too distorted, or a level cannot
 ///        be built without flipped triangles; nothing partial is returned.
-/// \throw OptionsError if an option is out of its range, or relax is new_vertices_only on the
-///        base_mesh domain.
+/// \throw OptionsError if check_options refuses the options.
 RemeshResult remesh(const TriMesh& input, const RemeshOptions& options);
 
 /// The report.json document of a result: options, parameterization and every level's stats.

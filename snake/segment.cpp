@@ -257,15 +257,15 @@ void check_snake_options(const std::string& at, const SnakeOptions& o) {
                                     {"tangential_weight", o.tangential_weight},
                                     {"tolerance", o.tolerance}})
     require_at_least(at + key, weight, 0.0);
-  require_in(at + "external_weight", o.external_weight, 0.0, 1.0);
+  require_at_least(at + "external_weight", o.external_weight, 0.0);
   require_positive(at + "time_step", o.time_step);
   require_positive(at + "max_step_fraction", o.max_step_fraction);
   for (const auto& [key, count] : {std::pair<const char*, int>{"offset_median", o.offset_median},
                                    {"offset_smoothing", o.offset_smoothing},
-                                   {"max_iterations", o.max_iterations},
                                    {"min_iterations", o.min_iterations},
                                    {"patience", o.patience}})
     require_at_least(at + key, count, 0);
+  require_in(at + "max_iterations", o.max_iterations, 0, kMaxSnakeIterations);
 }
 
 void check_search_options(const SegmentOptions& o) {
@@ -275,7 +275,6 @@ void check_search_options(const SegmentOptions& o) {
                                     {"profile_step_fraction", o.profile_step_fraction},
                                     {"window_voxels", o.window_voxels},
                                     {"edge_per_voxel", o.edge_per_voxel},
-                                    {"fit_tolerance_voxels", o.fit_tolerance_voxels},
                                     {"cost_ring_full_weight_cost", o.cost_ring_full_weight_cost},
                                     {"fine.profile_step_fraction", o.fine.profile_step_fraction}})
     require_positive(key, length);
@@ -287,12 +286,39 @@ void check_search_options(const SegmentOptions& o) {
                                    {"profile_distance_penalty", o.profile_distance_penalty},
                                    {"edge_distance_penalty", o.edge_distance_penalty},
                                    {"search_min_gain", o.search_min_gain},
+                                   {"fit_tolerance_voxels", o.fit_tolerance_voxels},
                                    {"clean_step_max_residual", o.clean_step_max_residual},
                                    {"min_edge_voxels", o.min_edge_voxels},
                                    {"fine.min_edge_voxels", o.fine.min_edge_voxels},
                                    {"fine.offset_smoothing_voxels", o.fine.offset_smoothing_voxels}})
     require_at_least(key, bound, 0.0);
   require_in("cost_ring_weight", o.cost_ring_weight, 0.0, 1.0);
+}
+
+void check_registration_options(const RegistrationOptions& o) {
+  const std::string at = "registration.itk.";
+  for (const auto& [key, count] : {std::pair<const char*, int>{"samples_per_level", o.samples_per_level},
+                                   {"evaluation_samples", o.evaluation_samples},
+                                   {"convergence_window", o.convergence_window},
+                                   {"threads", o.threads}})
+    require_at_least(at + key, count, 1);
+  require_in(at + "histogram_bins", o.histogram_bins, 5, 1024);
+  require_at_least(at + "iterations_per_level", o.iterations_per_level, 0);
+  require(!o.shrink_factors.empty() && o.shrink_factors.size() == o.smoothing_voxels.size(), at + "shrink_factors",
+          "one factor per level, as many as smoothing_voxels");
+  for (const int factor : o.shrink_factors) require_at_least(at + "shrink_factors[]", factor, 1);
+  for (const double sigma : o.smoothing_voxels) require_at_least(at + "smoothing_voxels[]", sigma, 0.0);
+  for (const auto& [key, length] : {std::pair<const char*, double>{"initial_step_voxels", o.initial_step_voxels},
+                                    {"step_factor_per_level", o.step_factor_per_level},
+                                    {"max_seconds", o.max_seconds}})
+    require_positive(at + key, length);
+  for (const auto& [key, bound] : {std::pair<const char*, double>{"min_step_voxels", o.min_step_voxels},
+                                   {"min_relative_change", o.min_relative_change},
+                                   {"moving_margin_fraction", o.moving_margin_fraction},
+                                   {"moving_margin_voxels", o.moving_margin_voxels},
+                                   {"rotation_radius_mm", o.rotation_radius_mm}})
+    require_at_least(at + key, bound, 0.0);
+  require_in(at + "relaxation", o.relaxation, 1e-3, 0.999);
 }
 
 void check_placement_options(const SegmentOptions& o) {
@@ -309,7 +335,8 @@ void check_placement_options(const SegmentOptions& o) {
   require_in("moments.max_rotation_deg", o.moments.max_rotation_deg, 0.0, 180.0);
   require_positive("registration.min_scale", o.registration.min_scale);
   require_at_least("registration.max_scale", o.registration.max_scale, o.registration.min_scale);
-  require_at_least("intensity_samples", o.intensity_samples, std::size_t{1});
+  require_in("intensity_samples", o.intensity_samples, std::size_t{1024}, std::size_t{1} << 30);
+  check_registration_options(o.registration.itk);
 }
 
 }  // namespace
@@ -334,7 +361,7 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
 
   // Image side: robust normalization and the pyramid.
   report(progress, "normalize", 0.0);
-  result.window = robust_intensity_window(image, 1.0, 99.0, std::max<std::size_t>(1024, options.intensity_samples));
+  result.window = robust_intensity_window(image, 1.0, 99.0, options.intensity_samples);
   clock.end("normalize");
   report(progress, "pyramid", 0.0);
   const NormalizedPyramid pyramid(image, result.window);

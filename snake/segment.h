@@ -81,6 +81,9 @@ struct FineLevelOptions {
   double profile_step_fraction = 1.0;
 };
 
+/// The most iterations a level may run: snake.max_iterations and --max-iterations.
+constexpr int kMaxSnakeIterations = 100000;
+
 struct SegmentOptions {
   SnakeOptions snake;
   InitMode init = InitMode::automatic;
@@ -122,8 +125,8 @@ struct SegmentOptions {
   double max_profile_cost = 0.4;  ///< profile matches with a correlation below 0.6 are ignored
   /// NormalSearchOptions::distance_penalty per force, and ::min_gain (forces.h). Measured
   /// with bench_snake_levels (profile force) on 10 synthetic blob/heart cases and 4 real ones
-  /// (liver, 4th ventricle, hippocampi): with the search's stale-minimum bug fixed, the old
-  /// 0.05 lost up to 0.0024 Dice (heart SNR 2); 0.02 with external_weight 0.35 lost at most
+  /// (liver, 4th ventricle, hippocampi): 0.05 lost up to 0.0024 Dice against the best (heart
+  /// SNR 2); 0.02 with external_weight 0.35 lost at most
   /// 0.0015 (liver) and raised the mean; more damping (0.15, or any min_gain) lost more. The
   /// step-edge force keeps 0.05: at 0.02 the aneurysm end-to-end case fell from 0.954 to 0.949.
   double profile_distance_penalty = 0.02;

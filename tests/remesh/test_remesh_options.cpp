@@ -73,7 +73,7 @@ TEST(RemeshOptionsJson, GivenKeysReplaceDefaultsAndRoundTrip) {
 }
 
 TEST(RemeshOptionsJson, RefusesUnknownKeysAndValues) {
-  // A misspelt nested key, and a flat name of the old layout, are named in the message.
+  // A misspelt nested key, and a flat (un-nested) name, are named in the message.
   EXPECT_NE(message_of_refusal({{"relaxation", {{"lloyd_iteration", 3}}}}).find("relaxation.lloyd_iteration"),
             std::string::npos);
   EXPECT_NE(message_of_refusal({{"lloyd_iterations", 3}}).find("'lloyd_iterations'"), std::string::npos);
@@ -156,16 +156,40 @@ TEST_F(RemeshConfigCli, ConfigFileChangesAFieldAndTheReportShowsIt) {
   EXPECT_EQ(deep.exit_code, 3) << deep.output;
   EXPECT_NE(deep.output.find("levels is 20; it must be in [0, 12]"), std::string::npos) << deep.output;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "deep"));
+  write_json(dir_ / "base.json", {{"domain", "base_mesh"}});
+  const auto strict = test::run_mrsnake("-q remesh " + input_ + " -o " + (dir_ / "strict").string() + " --config " +
+                                        (dir_ / "base.json").string() + " --strict");
+  EXPECT_EQ(strict.exit_code, 3) << strict.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "strict"));
 }
 
-TEST(RemeshOptionsCheck, ThePapersExactMethodIsRefusedOnTheBaseMeshDomain) {
+// The message of check_options(o, at), or "" if it accepts them.
+std::string refusal(const RemeshOptions& o, const std::string& at = "") {
+  try {
+    check_options(o, at);
+  } catch (const OptionsError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(RemeshOptionsCheck, ThePapersExactMethodIsRefusedOnTheBaseMeshDomainOnly) {
   RemeshOptions o;
-  o.domain = ParameterDomain::base_mesh;
+  EXPECT_EQ(refusal(o), "");
   o.relax = RelaxMode::new_vertices_only;
+  EXPECT_EQ(refusal(o), "");  // the sphere domain has it
+  o.domain = ParameterDomain::base_mesh;
+  EXPECT_NE(refusal(o, "remesh.").find("remesh.relax new_vertices_only"), std::string::npos) << refusal(o);
   EXPECT_THROW(remesh(ellipsoid(2), o), OptionsError);
-  o.domain = ParameterDomain::sphere;
+}
+
+TEST(RemeshOptionsCheck, AValueOutOfRangeIsRefusedByItsKeyWithThePrefix) {
+  RemeshOptions o;
   o.relaxation.surface_quality_floor = 1.5;
-  EXPECT_THROW(remesh(ellipsoid(2), o), OptionsError);
+  EXPECT_EQ(refusal(o, "remesh."), "the option remesh.relaxation.surface_quality_floor is 1.5; it must be in [0, 1]");
+  o = RemeshOptions{};
+  o.fit.regularization = 0;
+  EXPECT_EQ(refusal(o), "the option fit.regularization is 0; it must be a positive number");
 }
 
 TEST_F(RemeshConfigCli, ReportOptionsRepeatTheRunExactly) {

@@ -42,13 +42,16 @@ TEST(SegmentOptionsCheck, TheDefaultsPassAndAValueOutOfRangeIsRefusedByItsKey) {
   const Case cases[] = {
       {"snake.max_iterations is -1", [](SegmentOptions& o) { o.snake.max_iterations = -1; }},
       {"snake.time_step is 0", [](SegmentOptions& o) { o.snake.time_step = 0; }},
-      {"snake.external_weight is 2", [](SegmentOptions& o) { o.snake.external_weight = 2; }},
+      {"snake.external_weight is -1", [](SegmentOptions& o) { o.snake.external_weight = -1; }},
       {"step_voxels is nan", [](SegmentOptions& o) { o.step_voxels = std::nan(""); }},
+      {"step_voxels is 0", [](SegmentOptions& o) { o.step_voxels = 0; }},
+      {"snake.max_iterations is 100001", [](SegmentOptions& o) { o.snake.max_iterations = 100001; }},
+      {"registration.itk.shrink_factors[] is 0", [](SegmentOptions& o) { o.registration.itk.shrink_factors[0] = 0; }},
       {"fit_level is -3", [](SegmentOptions& o) { o.fit_level = -3; }},
       {"fit.trim_fraction is 1", [](SegmentOptions& o) { o.fit.trim_fraction = 1; }},
       {"fine.profile_step_fraction is -0.5", [](SegmentOptions& o) { o.fine.profile_step_fraction = -0.5; }},
       {"registration.max_scale is 0.4", [](SegmentOptions& o) { o.registration.max_scale = 0.4; }},
-      {"intensity_samples is 0", [](SegmentOptions& o) { o.intensity_samples = 0; }},
+      {"intensity_samples is 1000", [](SegmentOptions& o) { o.intensity_samples = 1000; }},
   };
   for (const Case& c : cases) {
     SegmentOptions o;
