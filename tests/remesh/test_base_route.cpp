@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "mesh/distance.h"
+#include "mesh/mesh_io.h"
 #include "mesh/primitives.h"
 #include "mesh/quality.h"
 #include "mesh/subdivision.h"
@@ -18,6 +19,7 @@
 #include "remesh/remesh.h"
 #include "remesh/remesh_options_json.h"
 #include "tests/remesh/remesh_shapes.h"
+#include "tests/test_support.h"
 
 namespace mrsnake {
 namespace {
@@ -147,6 +149,21 @@ TEST(BaseLevels, SplitPlacesMidpointsAndReportsAnEdgeWithNoChart) {
   BaseLayout moved = start;
   moved.points[p[0]] = BasePoint{far_face, Eigen::Vector3d::Constant(1.0 / 3)};
   EXPECT_FALSE(split_on_base(c, 1, domain, lift, moved));
+}
+
+// The octopus's tentacles stretch relaxed slivers across more than one chart of K, or fold
+// them, so that some levels start over from the dyadic split: the run goes on, unflipped. (Once
+// no level of it needs to, it no longer exercises the fallback: take a harder input.)
+TEST(BaseDomainRemesh, ALevelWhoseRelaxedSplitFailsStartsFromTheDyadicSplit) {
+  MRSNAKE_REQUIRE_DATA(path, "meshes/octopus.off");
+  const TriMesh input = read_mesh(path);
+  const RemeshResult r = remesh(input, base_domain_options(16000));
+  int restarted = 0;
+  for (const RemeshLevel& level : r.levels) {
+    EXPECT_EQ(level.flipped_triangles, 0);
+    if (level.stats["level"].get<int>() > 0 && level.stats["started_from"] == "dyadic split") ++restarted;
+  }
+  EXPECT_GE(restarted, 1);
 }
 
 // A flat disk whose rim wobbles, radius 1 + 0.25 sin 7θ, as a polar grid: `rings` rings of
