@@ -12,6 +12,7 @@
 #include <fstream>
 #include <limits>
 #include <set>
+#include <string>
 
 #include <nlohmann/json.hpp>
 #include <zlib.h>
@@ -246,6 +247,22 @@ TEST_F(Robustness, UnwritableOutput) {
                         4, "a-file");
 }
 
+// Whether process `pid`, once it runs mrsnake (its Name in /proc), catches `sig` (its SigCgt
+// mask), waiting up to 30 s for it.
+bool wait_for_handler(pid_t pid, int sig) {
+  for (int tries = 0; tries < 600; ++tries) {
+    std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+    bool mrsnake = false, catches = false;
+    for (std::string line; std::getline(status, line);) {
+      if (line.rfind("Name:", 0) == 0) mrsnake = line.find("mrsnake") != std::string::npos;
+      if (line.rfind("SigCgt:", 0) == 0) catches = std::stoull(line.substr(7), nullptr, 16) >> (sig - 1) & 1ULL;
+    }
+    if (mrsnake && catches) return true;
+    usleep(50000);
+  }
+  return false;
+}
+
 TEST_F(Robustness, InterruptLeavesNoPartialOutput) {
   const fs::path out = *dir_ / "interrupted";
   fs::create_directories(out);
@@ -260,7 +277,10 @@ TEST_F(Robustness, InterruptLeavesNoPartialOutput) {
             model.c_str(), "--faces", "130000", static_cast<char*>(nullptr));
       _exit(127);
     }
-    usleep(700000);  // build-model at 130k faces takes several seconds: interrupt it mid-way
+    // Interrupt it mid-way, once its handlers are in place: under the sanitizers and a loaded
+    // machine, starting up alone can take longer than a fixed wait.
+    ASSERT_TRUE(wait_for_handler(child, sig)) << "the command never installed its signal handler";
+    usleep(300000);  // build-model at 130k faces takes several seconds
     kill(child, sig);
     int status = 0;
     waitpid(child, &status, 0);
@@ -472,7 +492,7 @@ TEST(CommandLine, NonFiniteNumbersAreUsageErrors) {
 
 TEST(CommandLine, ANegativeIterationCountIsAUsageError) {
   // Unset, the count is the options' own; 0 writes the placed model; below that is a mistake.
-  for (const std::string& count : {"-3", "-1"}) {
+  for (const std::string count : {"-3", "-1"}) {
     const auto r = run_mrsnake("segment --model m --image i.nii.gz -o o --max-iterations " + count);
     EXPECT_EQ(r.exit_code, 2) << count << "\n" << r.output;
     EXPECT_NE(r.output.find("--max-iterations"), std::string::npos) << count << "\n" << r.output;
