@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
+#include <vector>
 #include <memory>
 #include <optional>
 
@@ -14,6 +16,10 @@
 #include "mesh/image_io.h"
 #include "mesh/json_options.h"
 #include "model/build_model.h"
+#include "model/build_model_set.h"
+#include "model/label_names.h"
+#include "model/model_set.h"
+#include "apps/report/html.h"
 #include "model/build_model_json.h"
 #include "model/model_io.h"
 
@@ -48,8 +54,7 @@ std::string poor_fit_cause(const StructureScale& scale, const SurfaceChoices& c)
 
 // The command's arguments: the options file, and the flags that override it.
 struct BuildModelArgs {
-  std::string labels, image, output, config;
-  int label = 1;
+  std::string labels, image, output, config, label = "1", label_names;
   std::optional<int> faces, component, close_tunnels;
   bool allow_poor_fit = false, json = false;
 };
@@ -57,7 +62,6 @@ struct BuildModelArgs {
 // The file's options (or the preset), then the flags given.
 BuildModelOptions options_of(const BuildModelArgs& a) {
   BuildModelOptions o = a.config.empty() ? BuildModelOptions{} : read_options_file<BuildModelOptions>(a.config);
-  o.label = a.label;
   if (a.faces) {
     o.faces = *a.faces;
     o.levels = 0;
@@ -73,11 +77,17 @@ SurfaceChoices choices_of(const BuildModelOptions& o, double mc_spacing, int clo
   return {mc_spacing, o.surface.mc_spacing_mm >= 0, o.faces > 0 || o.levels > 0, closing_radius};
 }
 
-// The library's model, with the command's hints on what to type when it is refused.
-BuiltModel build_with_hints(const Volume& labels, const Volume* image, const BuildModelOptions& o,
-                            const ProgressFn& progress) {
+// The library's models, with the command's hints on what to type when one is refused.
+BuiltModelSet build_with_hints(const Volume& labels, const Volume* image, const LabelSelection& selection,
+                               const std::map<int, LabelName>& names, const BuildModelOptions& o,
+                               const ProgressFn& progress) {
+  const auto announce = [](int value, const std::string& name, int index, int count) {
+    if (count > 1)
+      info("[" + std::to_string(index + 1) + "/" + std::to_string(count) + "] label " + std::to_string(value) + " (" +
+           name + ")");
+  };
   try {
-    return build_model(labels, image, o, progress);
+    return build_model_set(labels, image, selection, names, o, progress, announce);
   } catch (const LabelGenusError& e) {
     throw TopologyError(std::string(e.what()) +
                         (o.surface.close_tunnels > 0
@@ -91,14 +101,14 @@ BuiltModel build_with_hints(const Volume& labels, const Volume* image, const Bui
 }
 
 // What the user should know of the surface: parts dropped, tunnels closed, a poor fit kept.
-void warn_about(const BuiltModel& built, const BuildModelOptions& o) {
+void warn_about(const BuiltModel& built, const BuildModelOptions& o, int value) {
   const LabelSurface& s = built.surface;
   if (!s.dropped_component_faces.empty())
-    warn("label " + std::to_string(o.label) + " has " + std::to_string(s.components_found) +
+    warn("label " + std::to_string(value) + " has " + std::to_string(s.components_found) +
          " connected surfaces; the model uses the largest" +
          (o.component > 0 ? std::string() : std::string(" (--component K models the K-th largest part of the label)")));
   if (s.closing_radius > 0)
-    warn("label " + std::to_string(o.label) + " had a genus-" + std::to_string(s.genus_before_repair) +
+    warn("label " + std::to_string(value) + " had a genus-" + std::to_string(s.genus_before_repair) +
          " surface; closed its tunnels with a radius of " + std::to_string(s.closing_radius) + " voxels");
   if (!(built.fit.dice >= kMinLabelFitDice))
     warn(describe_poor_fit(built.fit) +
@@ -106,7 +116,8 @@ void warn_about(const BuiltModel& built, const BuildModelOptions& o) {
 }
 
 // report.html: every level against the input, and the unrelaxed hierarchy when asked for.
-std::string report_page(const BuildModelArgs& a, const BuiltModel& built, const ProgressFn& progress) {
+std::string report_page(const BuildModelArgs& a, const BuiltStructure& structure, const ProgressFn& progress) {
+  const BuiltModel& built = structure.built;
   report(progress, "report.html", 0.0);
   mrsnake::reports::RemeshPageOptions page;
   page.title = "mrsnake build-model " + std::filesystem::path(a.output).filename().string();
@@ -115,7 +126,7 @@ std::string report_page(const BuildModelArgs& a, const BuiltModel& built, const 
   page.input_locator = built.hierarchy.input_locator.get();
   page.unrelaxed = built.unrelaxed ? &*built.unrelaxed : nullptr;
   page.report = built.model.remesh_quality;
-  page.report["input"] = a.labels + " (label " + std::to_string(a.label) + ")";
+  page.report["input"] = a.labels + " (label " + std::to_string(structure.value) + ", " + structure.label.name + ")";
   page.timings = built.timings;
   const std::string html = mrsnake::reports::remesh_report_html(built.hierarchy, page);
   report(progress, "report.html", 1.0);
@@ -184,49 +195,148 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// Read, build, write the model folder with its report page, and print what was done.
+// The page of a model of several structures: one row per structure and per skipped label;
+// each structure's own page is structures/<value>/report.html.
+std::string index_page(const BuildModelArgs& a, const BuiltModelSet& set) {
+  mrsnake::reports::HtmlPage page("mrsnake build-model " + std::filesystem::path(a.output).filename().string());
+  page.paragraph("From " + a.labels + (a.image.empty() ? std::string() : " and the image " + a.image) + ": " +
+                 std::to_string(set.structures.size()) + " structures, " + std::to_string(set.skipped.size()) +
+                 " labels skipped. Each structure's remeshing report is structures/VALUE/report.html.");
+  std::vector<std::vector<std::string>> rows;
+  char text[64];
+  for (const BuiltStructure& s : set.structures) {
+    const auto& conn = s.built.hierarchy.connectivity;
+    std::vector<std::string> row{std::to_string(s.value), s.label.name, std::to_string(conn.levels()),
+                                 std::to_string(conn.faces.back().rows())};
+    std::snprintf(text, sizeof text, "%.4g", s.built.scale.volume_mm3);
+    row.emplace_back(text);
+    std::snprintf(text, sizeof text, "%.4f", s.built.fit.dice);
+    row.emplace_back(text);
+    row.push_back("<a href='structures/" + std::to_string(s.value) + "/report.html'>page</a>");
+    rows.push_back(std::move(row));
+  }
+  page.heading("Structures");
+  page.table({"value", "name", "levels", "faces", "volume mm3", "fit Dice", "report"}, rows);
+  if (!set.skipped.empty()) {
+    std::vector<std::vector<std::string>> skipped;
+    for (const SkippedLabel& k : set.skipped)
+      skipped.push_back(
+          {std::to_string(k.value), mrsnake::reports::escape_html(k.name), mrsnake::reports::escape_html(k.reason)});
+    page.heading("Skipped labels");
+    page.table({"value", "name", "reason"}, skipped);
+  }
+  return page.str();
+}
+
+nlohmann::json set_summary_json(const BuildModelArgs& a, const BuiltModelSet& set, double total_seconds) {
+  nlohmann::json structures = nlohmann::json::array();
+  for (const BuiltStructure& s : set.structures) {
+    nlohmann::json j = summary_json(a, s.built, 0.0);
+    j.erase("total_seconds");
+    j["value"] = s.value;
+    j["name"] = s.label.name;
+    structures.push_back(std::move(j));
+  }
+  nlohmann::json skipped = nlohmann::json::array();
+  for (const SkippedLabel& k : set.skipped)
+    skipped.push_back({{"value", k.value}, {"name", k.name}, {"reason", k.reason}});
+  return {
+      {"model", a.output},
+      {"structures", structures},
+      {"skipped", skipped},
+      {"reference_margin_mm", set.reference_image.empty() ? nlohmann::json() : nlohmann::json(set.reference_margin_mm)},
+      {"total_seconds", total_seconds}};
+}
+
+void print_set_summary(const BuildModelArgs& a, const BuiltModelSet& set, double total_seconds) {
+  std::cout << a.output << ": " << set.structures.size() << " structures";
+  if (!set.skipped.empty()) std::cout << ", " << set.skipped.size() << " labels skipped";
+  std::cout << "\n  value  levels      faces   fit Dice  name\n";
+  for (const BuiltStructure& s : set.structures)
+    std::printf("  %5d %7d %10ld   %8.4f  %s\n", s.value, s.built.hierarchy.connectivity.levels(),
+                static_cast<long>(s.built.hierarchy.connectivity.faces.back().rows()), s.built.fit.dice,
+                s.label.name.c_str());
+  std::printf("  total %.3f s\n", total_seconds);
+  std::fflush(stdout);
+}
+
+// Each structure's page into its folder, and the index (or, for one structure, its page) on top.
+void write_pages(const BuildModelArgs& a, const BuiltModelSet& set, const std::vector<std::string>& pages,
+                 const std::string& temp_folder) {
+  const std::filesystem::path temp(temp_folder);
+  if (set.structures.size() == 1) {
+    write_text_file_atomically((temp / "report.html").string(), pages[0]);
+    return;
+  }
+  for (std::size_t i = 0; i < set.structures.size(); ++i)
+    write_text_file_atomically((temp / "structures" / std::to_string(set.structures[i].value) / "report.html").string(),
+                               pages[i]);
+  write_text_file_atomically((temp / "report.html").string(), index_page(a, set));
+}
+
+// Read, build, write the model folder with its report pages, and print what was done.
 void run_build_model(const BuildModelArgs& a) {
   const auto t_start = std::chrono::steady_clock::now();
   const auto progress = terminal_progress();
   const BuildModelOptions options = options_of(a);
+  const LabelSelection selection = parse_label_selection(a.label);
+  if (options.component > 0 && (selection.all || selection.values.size() > 1))
+    throw OptionsError("--component models a part of one label; give one --label value with it");
+  const std::map<int, LabelName> names =
+      a.label_names.empty() ? std::map<int, LabelName>{} : read_label_names(a.label_names);
   report(progress, "reading " + a.labels, 0.0);
   const Volume labels = read_volume(a.labels);
   const std::optional<Volume> image = a.image.empty() ? std::nullopt : std::optional<Volume>(read_volume(a.image));
   const double read_seconds = seconds_since(t_start);
 
-  BuiltModel built = build_with_hints(labels, image ? &*image : nullptr, options, progress);
-  warn_about(built, options);
-  built.model.source_image = a.labels;
-  // The manifest records every stage up to the write; the write's own time is printed.
-  built.timings.insert(built.timings.begin(), {"read", read_seconds});
-  built.model.timings = built.timings;
-
-  // report.html goes into the model folder with the rest, inside the same atomic write.
-  auto t = std::chrono::steady_clock::now();
-  const std::string html = report_page(a, built, progress);
-  built.timings.emplace_back("report", seconds_since(t));
-  t = std::chrono::steady_clock::now();
-  save_model(a.output, built.model, progress, [&html](const std::string& temp_folder) {
-    write_text_file_atomically((std::filesystem::path(temp_folder) / "report.html").string(), html);
-  });
-  built.timings.emplace_back("write", seconds_since(t));
+  BuiltModelSet set = build_with_hints(labels, image ? &*image : nullptr, selection, names, options, progress);
+  for (const SkippedLabel& k : set.skipped)
+    warn("skipped label " + std::to_string(k.value) + " (" + k.name + "): " + k.reason);
+  std::vector<std::string> pages;
+  for (BuiltStructure& s : set.structures) {
+    warn_about(s.built, options, s.value);
+    s.built.model.source_image = a.labels;
+    // The manifest records every stage up to the write; the write's own time is printed.
+    s.built.timings.insert(s.built.timings.begin(), {"read", read_seconds});
+    s.built.model.timings = s.built.timings;
+    const auto t = std::chrono::steady_clock::now();
+    pages.push_back(report_page(a, s, progress));
+    s.built.timings.emplace_back("report", seconds_since(t));
+  }
+  // The pages go into the model folder with the rest, inside the same atomic write.
+  const auto t = std::chrono::steady_clock::now();
+  save_model_set(a.output, set.model_set(a.labels), progress,
+                 [&](const std::string& temp_folder) { write_pages(a, set, pages, temp_folder); });
+  const double write_seconds = seconds_since(t);
+  for (BuiltStructure& s : set.structures) s.built.timings.emplace_back("write", write_seconds);
   const double total = seconds_since(t_start);
+  const bool one = set.structures.size() == 1 && !selection.all;
   if (a.json)
-    print_json(summary_json(a, built, total));
+    print_json(one ? summary_json(a, set.structures[0].built, total) : set_summary_json(a, set, total));
+  else if (one)
+    print_summary(a, set.structures[0].built, total);
   else
-    print_summary(a, built, total);
+    print_set_summary(a, set, total);
 }
 
 }  // namespace
 
 void add_build_model_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("build-model",
-                                 "Build a multiresolution shape model from one label of a label image: marching cubes, "
-                                 "semi-regular remeshing, lifting-wavelet analysis");
+  auto* cmd =
+      app.add_subcommand("build-model",
+                         "Build a multiresolution shape model of one or more labels of a label image: marching cubes, "
+                         "semi-regular remeshing, lifting-wavelet analysis");
   auto a = std::make_shared<BuildModelArgs>();
   cmd->add_option("--labels", a->labels, "Label volume (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)")
       ->required();
-  cmd->add_option("--label", a->label, "Label value of the object")->required();
+  cmd->add_option("--label", a->label,
+                  "Label values of the structures, e.g. 5 or 1,3,7,8, or all: every label whose surface is closed "
+                  "genus 0 (after --close-tunnels), the others skipped with their reason; one model folder holds them")
+      ->required();
+  cmd->add_option("--label-names", a->label_names,
+                  "Names (and colours) of the labels: an ITK-SNAP label description file, or a CSV of value,name rows; "
+                  "kept in the model and written into the segmentation's outputs (default: 'label N')")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--image", a->image,
                   "Reference intensity image of the labels (same physical space): stores the appearance "
                   "(profiles along the normals, inside/outside statistics) that 'mrsnake segment' matches, and a "

@@ -27,6 +27,7 @@
 #include "mesh/mesh_io.h"
 #include "mesh/parallel.h"
 #include "evaluation/evaluate.h"
+#include "apps/segment_case.h"
 #include "model/snake_adapter.h"
 #include "snake/rasterize.h"
 #include "snake/segment.h"
@@ -35,180 +36,6 @@
 namespace mrsnake::cli {
 
 namespace {
-
-// report.html: slices with the contours, a render, convergence per level, timings.
-void write_segment_page(const std::filesystem::path& path, const std::string& image_path, const Volume& image,
-                        const Volume* truth, int truth_label, const SegmentResult& result, const nlohmann::json& rep) {
-  mrsnake::reports::SegmentPageInput page;
-  page.title = "mrsnake segment " + std::filesystem::path(image_path).filename().string();
-  page.image = &image;
-  page.surface = &result.surface;
-  if (truth) {
-    page.truth = truth;
-    page.truth_label = static_cast<float>(truth_label);
-  }
-  for (const LevelOutcome& l : result.levels) {
-    mrsnake::reports::SnakeConvergence c;
-    c.level = l.level;
-    c.deformed = l.deformed;
-    for (const auto& it : l.snake.history) {
-      c.energy.push_back(it.energy);
-      c.external_energy.push_back(it.external_energy);
-      c.internal_energy.push_back(it.internal_energy);
-      c.mean_abs_offset_mm.push_back(it.mean_abs_offset_mm);
-    }
-    page.convergence.push_back(std::move(c));
-  }
-  page.report = rep;
-  mrsnake::reports::write_segment_report(path.string(), page);
-}
-
-// A result whose volume is off the model's by more than this factor, either way, is flagged.
-// A heuristic: between the four mice the same structure's volume differs by at most 1.3×;
-// organs that vary more between subjects will raise it more often.
-constexpr double kMaxVolumeFactor = 1.5;
-
-// report.json's verdict on a result: "suspect" (bool) and "reason" (empty when not), from
-// the segmented volume against the model's. (A rejected registration is not a verdict by
-// itself: its fallback often succeeds, e.g. on synthetic blobs, and it is warned about.)
-void flag_doubtful_result(nlohmann::json& rep, const SnakeModel& model) {
-  const int L = model.finest_level();
-  const double model_volume = enclosed_volume(TriMesh{model.levels[L], model.faces(L)});
-  const double volume = rep["volume_mm3"].get<double>();
-  const double ratio = model_volume > 0 ? volume / model_volume : 0.0;
-  rep["model_volume_mm3"] = model_volume;
-  rep["volume_ratio_to_model"] = ratio;
-  std::vector<std::string> reasons;
-  if (!(model_volume > 0)) {
-    reasons.emplace_back("the model's finest level encloses no volume; rebuild the model");
-  } else if (!(ratio <= kMaxVolumeFactor && ratio >= 1.0 / kMaxVolumeFactor)) {
-    char text[160];
-    std::snprintf(text, sizeof text, "the volume is %.2f times the model's (accepted: %.2f to %.2f)", ratio,
-                  1.0 / kMaxVolumeFactor, kMaxVolumeFactor);
-    reasons.emplace_back(text);
-  }
-  std::string reason;
-  for (const std::string& r : reasons) reason += (reason.empty() ? "" : "; ") + r;
-  rep["suspect"] = !reasons.empty();
-  rep["reason"] = reason;
-}
-
-double seconds_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
-// The labels of `surface` on the image's grid (1 inside), and the seconds they took.
-void rasterize_timed(const TriMesh& surface, const Volume& image, Volume& labels, double& seconds) {
-  const auto t = std::chrono::steady_clock::now();
-  labels = rasterize_mesh(surface, image, 1.0f);
-  seconds = seconds_since(t);
-}
-
-// The self-intersections of `surface`, and the seconds their count took.
-void count_self_intersections_timed(const TriMesh& surface, int& count, double& seconds) {
-  const auto t = std::chrono::steady_clock::now();
-  count = count_self_intersections(surface);
-  seconds = seconds_since(t);
-}
-
-// surface.vtp, levels/level_j.vtp and report.json into `dir`.
-void write_meshes(const std::filesystem::path& dir, const SegmentResult& result, const nlohmann::json& rep) {
-  write_mesh((dir / "surface.vtp").string(), result.surface);
-  for (const LevelOutcome& l : result.levels)
-    write_mesh((dir / "levels" / ("level_" + std::to_string(l.level) + ".vtp")).string(), l.surface);
-  write_text_file_atomically((dir / "report.json").string(), json_text(rep, 2) + "\n");
-}
-
-// One image to segment, and where.
-struct SegmentCase {
-  std::string image, truth, output;
-  int truth_label = 1;
-};
-
-struct SegmentCaseOutcome {
-  nlohmann::json report;
-  SegmentResult result;
-};
-
-// One image segmented into its output folder: the image (and truth) read, the snake, the
-// labels and the self-intersection count, then every output written to a temporary folder
-// renamed into place. Returns report.json's content and the segmentation.
-SegmentCaseOutcome segment_case(const SegmentCase& c, const SnakeModel& model, const std::string& model_path,
-                                const SegmentOptions& options, double model_load_seconds, const ProgressFn& progress) {
-  // The folder is replaced at the end: only an earlier result may be, never other data (an
-  // output named after a DICOM input folder would be that folder). Checked before the work too.
-  const ReplaceableFolder earlier = folder_of_entries(
-      [](const std::string& name) {
-        return name == "surface.vtp" || name == "labels.nii.gz" || name == "levels" || name == "report.json" ||
-               name == "report.html";
-      },
-      "an output of mrsnake segment");
-  require_replaceable(c.output, earlier);
-  const auto t_load = std::chrono::steady_clock::now();
-  report(progress, "load", 0.0);
-  const Volume image = read_volume(c.image);
-  Volume truth;
-  if (!c.truth.empty()) {
-    truth = read_volume(c.truth);
-    require_same_grid(image, truth, "IMAGE", "TRUTH");
-  }
-  const double load_seconds =
-      model_load_seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - t_load).count();
-
-  // The self-intersection count runs below, beside the rasterization.
-  SegmentOptions case_options = options;
-  case_options.count_self_intersections = false;
-  SegmentCaseOutcome outcome;
-  SegmentResult& result = outcome.result;
-  result = segment(image, model, case_options, progress);
-  if (result.registration && !result.registration->accepted)
-    warn("the reference image registration was not used (" + result.registration->rejection + "); initialized with " +
-         to_string(result.init) + " instead");
-  report(progress, "rasterize", 0.0);
-  Volume labels;
-  double rasterize_seconds = 0, count_seconds = 0;
-  run_both_in_parallel(
-      [&] { rasterize_timed(result.surface, image, labels, rasterize_seconds); },
-      [&] { count_self_intersections_timed(result.surface, result.self_intersections, count_seconds); });
-  result.stage_seconds.emplace_back("self_intersections", count_seconds);
-
-  nlohmann::json& rep = outcome.report;
-  rep = segment_report(result);
-  rep["image"] = c.image;
-  rep["model"] = model_path;
-  rep["init"] = to_string(options.init);
-  rep["options"] = options;  // as given (the count of self-intersections included): what --config reads
-  rep["stage_seconds"]["load"] = load_seconds;
-  rep["stage_seconds"]["rasterize"] = rasterize_seconds;
-  // What a screening study compares: the organ's volume, as labels.nii.gz holds it.
-  const auto inside = static_cast<double>(std::count(labels.data.begin(), labels.data.end(), 1.0f));
-  rep["volume_mm3"] = inside * labels.spacing[0] * labels.spacing[1] * labels.spacing[2];
-  flag_doubtful_result(rep, model);
-  if (rep["suspect"].get<bool>()) warn("the result is doubtful: " + rep["reason"].get<std::string>());
-  if (!c.truth.empty()) {
-    report(progress, "evaluate", 0.0);
-    nlohmann::json scores;
-    to_json(scores, evaluate_segmentation(labels, truth, 1, c.truth_label));
-    rep["scores"] = scores;
-    rep["truth"] = c.truth;
-  }
-
-  // Everything goes to a temporary folder renamed into place at the end.
-  report(progress, "write", 0.0);
-  AtomicDirectory out(c.output, earlier);
-  const std::filesystem::path dir = out.temp_path();
-  std::filesystem::create_directories(dir / "levels");
-  // The compressed labels are written on the other core, beside the meshes.
-  run_both_in_parallel([&] { write_meshes(dir, result, rep); },
-                       [&] { write_volume((dir / "labels.nii.gz").string(), labels, VoxelType::uint8); });
-  // After the join: the page's render forks a child, which must not start while another
-  // thread may hold a lock (the allocator's, the loader's) that the child would then wait on.
-  write_segment_page(dir / "report.html", c.image, image, c.truth.empty() ? nullptr : &truth, c.truth_label, result,
-                     rep);
-  out.commit();
-  report(progress, "done", 1.0);
-  return outcome;
-}
 
 // The options segment and segment-batch share, and the SegmentOptions they give.
 // With --config, the file's options, and of the flags only those given.
@@ -254,11 +81,29 @@ struct SnakeArgs {
   }
 };
 
-// The model, read once, and how long that took.
-std::pair<SnakeModel, double> load_snake_model(const std::string& path) {
-  const auto t = std::chrono::steady_clock::now();
-  SnakeModel model = snake_model_from(load_model(path));
-  return {std::move(model), std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count()};
+// What `segment` prints: the compute time, and per structure its volume, verdict and scores.
+void print_case_summary(const SegmentCase& c, const SegmentModel& model, const SegmentCaseOutcome& outcome) {
+  const nlohmann::json& rep = outcome.report;
+  char line[240];
+  std::snprintf(line, sizeof line, "segmented %s in %.3f s of compute (%zu structure%s)", c.image.c_str(),
+                rep["compute_seconds"].get<double>(), model.structures.size(), model.structures.size() == 1 ? "" : "s");
+  info(line);
+  for (const nlohmann::json& s : rep["structures"]) {
+    std::snprintf(line, sizeof line, "  %d %s: %.4g mm3, %d vertices, %d self-intersections%s", s["value"].get<int>(),
+                  s["name"].get<std::string>().c_str(), s["volume_mm3"].get<double>(), s["vertices"].get<int>(),
+                  s["self_intersections"].get<int>(), s["suspect"].get<bool>() ? ", SUSPECT" : "");
+    std::string text = line;
+    if (s.contains("scores") && s["scores"].contains("dice")) {
+      const auto& sc = s["scores"];
+      std::snprintf(line, sizeof line, "; Dice %.4f, ASSD %.3f mm, HD95 %.3f mm", sc["dice"].get<double>(),
+                    sc["assd_mm"].is_null() ? INFINITY : sc["assd_mm"].get<double>(),
+                    sc["hd95_mm"].is_null() ? INFINITY : sc["hd95_mm"].get<double>());
+      text += line;
+    }
+    info(text);
+  }
+  info("wrote " + c.output + "/{labels.nii.gz, surfaces/, report.json, report.html" +
+       (model.structures.size() == 1 ? std::string(", surface.vtp, levels/}") : std::string("}")));
 }
 
 }  // namespace
@@ -271,23 +116,30 @@ void add_segment_command(CLI::App& app) {
     std::string model;
     SnakeArgs snake;
     bool json = false;
+    int truth_label = 1;
+    const CLI::Option* truth_label_flag = nullptr;
   };
   auto a = std::make_shared<Args>();
   cmd->add_option("--image", a->c.image, "Volume to segment (.nii.gz .nrrd .mha ..., or a DICOM folder)")->required();
   cmd->add_option("--model", a->model, "Shape model folder (made by 'mrsnake build-model')")->required();
   cmd->add_option("-o,--output", a->c.output,
-                  "Output folder: surface.vtp, labels.nii.gz, levels/level_j.vtp, report.json, report.html")
+                  "Output folder: labels.nii.gz (the reference's label values), surfaces/VALUE.vtp, report.json, "
+                  "report.html; for a model of one structure also surface.vtp and levels/level_j.vtp")
       ->required();
   a->snake.add_to(cmd);
   cmd->add_option("--truth", a->c.truth,
                   "Truth labels on the image's grid: adds the scores of 'mrsnake evaluate' to the report");
-  cmd->add_option("--truth-label", a->c.truth_label, "Label of the object in --truth")->capture_default_str();
+  a->truth_label_flag = cmd->add_option("--truth-label", a->truth_label,
+                                        "Value of the structure in --truth, for a model of one structure (default 1); "
+                                        "a model of several is scored on each structure's own value");
   cmd->add_flag("--json", a->json, "Print the report as JSON on stdout");
   cmd->footer(
       "Example:\n"
       "  mrsnake segment --image case7/image.nii.gz --model heart.model -o case7/seg --truth case7/truth.nii.gz\n"
-      "Writes DIR/surface.vtp (final level), DIR/labels.nii.gz (1 inside, on the image's grid),\n"
-      "DIR/levels/level_j.vtp (each level after deformation), DIR/report.json and DIR/report.html.\n"
+      "Writes DIR/labels.nii.gz (every structure with its reference label value, on the image's grid; a voxel\n"
+      "inside two surfaces goes to the one it lies deepest inside), DIR/surfaces/VALUE.vtp per structure,\n"
+      "DIR/report.json (per structure: volume, scores, and 'suspect' with its 'reason') and DIR/report.html;\n"
+      "for a model of one structure also DIR/surface.vtp and DIR/levels/level_j.vtp (each level deformed).\n"
       "With a model built by 'build-model --image', the default initialization registers the model's\n"
       "reference image to IMAGE (ITK, similarity), then fits the coarse mesh; report.json's\n"
       "'registration' holds the transform, the metric and whether it was used or why not.\n"
@@ -296,24 +148,18 @@ void add_segment_command(CLI::App& app) {
     const auto progress = terminal_progress();
     const SegmentOptions options = a->snake.options();
     report(progress, "load", 0.0);
-    const auto [model, model_seconds] = load_snake_model(a->model);
-    const SegmentCaseOutcome outcome = segment_case(a->c, model, a->model, options, model_seconds, progress);
+    if (a->truth_label_flag->count() > 0) a->c.truth_label = a->truth_label;
+    const SegmentModel model = load_segment_model(a->model);
+    if (a->c.truth_label >= 0 && model.structures.size() > 1)
+      throw OptionsError(
+          "--truth-label names the structure's value in the truth for a model of one structure; the "
+          "truth of a model of several must hold the reference's values");
+    const SegmentCaseOutcome outcome = segment_case(a->c, model, a->model, options, model.load_seconds, progress);
     const nlohmann::json& rep = outcome.report;
-    const SegmentResult& result = outcome.result;
     if (a->json) {
       print_json(rep);
     } else {
-      info("segmented " + a->c.image + " in " + std::to_string(result.compute_seconds) + " s of compute (" +
-           std::to_string(result.levels.size()) + " levels, " + std::to_string(result.surface.num_vertices()) +
-           " vertices, " + std::to_string(result.self_intersections) + " self-intersections)");
-      if (rep.contains("scores")) {
-        char line[160];
-        std::snprintf(line, sizeof line, "Dice %.4f, ASSD %.3f mm, HD95 %.3f mm", rep["scores"]["dice"].get<double>(),
-                      rep["scores"]["assd_mm"].is_null() ? INFINITY : rep["scores"]["assd_mm"].get<double>(),
-                      rep["scores"]["hd95_mm"].is_null() ? INFINITY : rep["scores"]["hd95_mm"].get<double>());
-        info(line);
-      }
-      info("wrote " + a->c.output + "/{surface.vtp, labels.nii.gz, levels/, report.json, report.html}");
+      print_case_summary(a->c, model, outcome);
     }
   });
 }
@@ -406,21 +252,45 @@ std::string csv_number(const nlohmann::json& value) {
   return text;
 }
 
-// batch.csv: one row per image, in the order given.
+// The structures of the batch's rows, by value, in their order: one column each.
+std::vector<std::string> structure_columns(const nlohmann::json& cases) {
+  std::vector<std::string> values;
+  for (const auto& c : cases)
+    if (c.contains("structures"))
+      for (const auto& [value, s] : c["structures"].items())
+        if (std::find(values.begin(), values.end(), value) == values.end()) values.push_back(value);
+  return values;
+}
+
+// One row's volume and verdict of each structure column.
+std::string structure_fields(const nlohmann::json& c, const std::vector<std::string>& values) {
+  std::string fields;
+  for (const std::string& v : values) {
+    const bool has = c.contains("structures") && c["structures"].contains(v);
+    fields += "," + (has ? csv_number(c["structures"][v]["volume_mm3"]) : std::string()) + "," +
+              (has ? std::string(c["structures"][v]["suspect"].get<bool>() ? "true" : "false") : std::string());
+  }
+  return fields;
+}
+
+// batch.csv: one row per image, in the order given, with each structure's volume and verdict.
 std::string batch_csv(const nlohmann::json& cases) {
+  const std::vector<std::string> values = structure_columns(cases);
   std::string csv =
       "image,output,status,volume_mm3,compute_seconds,load_seconds,wall_seconds,self_intersections,init_used,"
-      "registration,suspect,reason,error\n";
+      "registration,suspect,reason,error";
+  for (const std::string& v : values) csv += ",volume_mm3_" + v + ",suspect_" + v;
+  csv += "\n";
   for (const auto& c : cases) {
     csv += csv_field(c["image"].get<std::string>()) + "," + csv_field(c["output"].get<std::string>()) + "," +
            c["status"].get<std::string>() + "," + csv_number(c.value("volume_mm3", nlohmann::json())) + "," +
            csv_number(c.value("compute_seconds", nlohmann::json())) + "," +
            csv_number(c.value("load_seconds", nlohmann::json())) + "," + csv_number(c["wall_seconds"]) + "," +
-           (c.contains("self_intersections") ? std::to_string(c["self_intersections"].get<int>()) : std::string()) +
-           "," + csv_field(c.value("init_used", std::string())) + "," +
-           csv_field(c.value("registration", std::string())) + "," +
-           (c.contains("suspect") ? std::string(c["suspect"].get<bool>() ? "true" : "false") : std::string()) + "," +
-           csv_field(c.value("reason", std::string())) + "," + csv_field(c.value("error", std::string())) + "\n";
+           (c.contains("self_intersections") ? csv_number(c["self_intersections"]) : std::string()) + "," +
+           csv_field(c.value("init_used", std::string())) + "," + csv_field(c.value("registration", std::string())) +
+           "," + (c.contains("suspect") ? std::string(c["suspect"].get<bool>() ? "true" : "false") : std::string()) +
+           "," + csv_field(c.value("reason", std::string())) + "," + csv_field(c.value("error", std::string())) +
+           structure_fields(c, values) + "\n";
   }
   return csv;
 }
@@ -445,7 +315,7 @@ std::vector<std::string> read_image_list(const std::string& list) {
 
 // One image of a batch: its row of batch.json. The image's own failures are recorded in the
 // row, not thrown: the batch goes on.
-nlohmann::json batch_row(const std::string& image, const std::string& output, const SnakeModel& model,
+nlohmann::json batch_row(const std::string& image, const std::string& output, const SegmentModel& model,
                          const std::string& model_path, const SegmentOptions& options, const ProgressFn& progress) {
   const auto t_case = std::chrono::steady_clock::now();
   nlohmann::json row = {{"image", image}, {"output", output}};
@@ -460,13 +330,18 @@ nlohmann::json batch_row(const std::string& image, const std::string& output, co
     c.output = output;
     const nlohmann::json rep = segment_case(c, model, model_path, options, 0.0, progress).report;
     row["status"] = "ok";
-    row["volume_mm3"] = rep["volume_mm3"];
+    row["volume_mm3"] = rep.value("volume_mm3", nlohmann::json());
     row["compute_seconds"] = rep["compute_seconds"];
     row["load_seconds"] = rep["stage_seconds"]["load"];
     row["self_intersections"] = rep["self_intersections"];
     row["init_used"] = rep.value("init_used", std::string());
     row["suspect"] = rep["suspect"];
     row["reason"] = rep["reason"];
+    nlohmann::json volumes = nlohmann::json::object();
+    for (const nlohmann::json& s : rep["structures"])
+      volumes[std::to_string(s["value"].get<int>())] = {
+          {"name", s["name"]}, {"volume_mm3", s["volume_mm3"]}, {"suspect", s["suspect"]}};
+    row["structures"] = volumes;
     if (rep.contains("registration"))
       row["registration"] = rep["registration"].value("accepted", false) ? "accepted" : "rejected";
   } catch (const Error& e) {
@@ -522,7 +397,8 @@ void add_segment_batch_command(CLI::App& app) {
     }
     if (images.empty()) throw CLI::ValidationError("images", "give the volumes to segment, or --list FILE");
     const SegmentOptions options = a->snake.options();
-    const auto [model, model_seconds] = load_snake_model(a->model);
+    const SegmentModel model = load_segment_model(a->model);
+    const double model_seconds = model.load_seconds;
     ensure_writable_directory(a->output);
     const std::filesystem::path dir(a->output);
     std::vector<std::string> outputs;
@@ -540,10 +416,16 @@ void add_segment_batch_command(CLI::App& app) {
       const std::string name = std::filesystem::path(outputs[i]).filename().string();
       if (row["status"] == "ok") {
         char line[200];
-        std::snprintf(line, sizeof line, "%s%s: %.3f s of compute, volume %.1f mm3, %d self-intersections",
-                      position.c_str(), name.c_str(), row["compute_seconds"].get<double>(),
-                      row["volume_mm3"].get<double>(), row["self_intersections"].get<int>());
-        info(line);
+        std::snprintf(line, sizeof line, "%s%s: %.3f s of compute, %zu structure%s", position.c_str(), name.c_str(),
+                      row["compute_seconds"].get<double>(), row["structures"].size(),
+                      row["structures"].size() == 1 ? "" : "s");
+        std::string text = line;
+        if (row["volume_mm3"].is_number()) {
+          std::snprintf(line, sizeof line, ", volume %.1f mm3", row["volume_mm3"].get<double>());
+          text += line;
+        }
+        if (row["suspect"].get<bool>()) text += "; doubtful: " + row["reason"].get<std::string>();
+        info(text);
       } else {
         ++failed;
         warn(position + name + " failed: " + row["error"].get<std::string>());

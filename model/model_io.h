@@ -15,8 +15,11 @@
 
 namespace mrsnake {
 
-/// The model format this build writes and the newest it reads.
-constexpr int kModelFormatVersion = 1;
+/// The newest model format this build reads: version 2 is a model of one or more structures
+/// (model_set.h), each kept as a version-1 folder of one structure, which save_model writes.
+constexpr int kModelFormatVersion = 2;
+/// The format of one structure's folder (save_model, load_model).
+constexpr int kStructureFormatVersion = 1;
 
 /// FNV-1a 64-bit hash of a byte range (the checksum of every model part).
 std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size);
@@ -40,7 +43,8 @@ struct LoadModelOptions {
 /// with its size and checksum, the binary layout and its own checksum, and the counts
 /// against the connectivity.
 /// \throw InputError with a message naming the model, the part and the defect (missing,
-///        truncated, altered, newer version, inconsistent); never returns a partial model.
+///        truncated, altered, newer version, inconsistent), or if the folder is a model of
+///        structures (format version 2: read it with load_model_set); never returns a partial model.
 ShapeModel load_model(const std::string& folder, const LoadModelOptions& options = {});
 
 /// The validated manifest (model.json) of a model folder, without reading the other parts.

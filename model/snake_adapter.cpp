@@ -1,6 +1,7 @@
 #include "model/snake_adapter.h"
 
 #include <memory>
+#include <optional>
 
 #include "mesh/errors.h"
 #include "model/sections.h"
@@ -51,13 +52,29 @@ ProfileAlignmentReport add_appearance(ShapeModel& model, const Volume& reference
   return alignment;
 }
 
-void add_reference_image(ShapeModel& model, const Volume& reference_image, const ReferenceImageOptions& options) {
-  const std::vector<RowMatrixX3d> levels = model_levels(model);
+std::vector<std::uint8_t> reference_image_section(const Volume& reference_image, const RowMatrixX3d& V,
+                                                  const ReferenceImageOptions& options) {
   // The whole image's window, as segment normalizes a new image.
   const IntensityWindow window = robust_intensity_window(reference_image);
-  Volume crop = make_reference_crop(reference_image, levels.back(), options);
+  Volume crop = make_reference_crop(reference_image, V, options);
   apply_intensity_window(crop, window);
-  model.sections[kReferenceImageSection] = serialize_reference_image(crop);
+  return serialize_reference_image(crop);
+}
+
+void add_reference_image(ShapeModel& model, const Volume& reference_image, const ReferenceImageOptions& options) {
+  model.sections[kReferenceImageSection] =
+      reference_image_section(reference_image, model_levels(model).back(), options);
+}
+
+std::vector<SnakeModel> snake_models_from(const ModelSet& set) {
+  std::optional<Volume> shared;
+  if (!set.reference_image.empty()) shared = deserialize_reference_image(set.reference_image);
+  std::vector<SnakeModel> models;
+  for (const ModelStructure& s : set.structures) {
+    models.push_back(snake_model_from(s.model));
+    if (shared) models.back().reference_image = shared;
+  }
+  return models;
 }
 
 }  // namespace mrsnake

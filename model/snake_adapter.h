@@ -3,10 +3,14 @@
 /// The shape model on disk (model/shape_model.h) as the segmentation sees it: its levels, a
 /// synthesis step from a deformed S_j with the stored details, and the optional appearance
 /// section ("appearance") that build-model --image adds.
+#include <cstdint>
+#include <vector>
+
 #include "mesh/volume.h"
 #include "snake/appearance.h"
 #include "snake/reference_image.h"
 #include "snake/segment.h"
+#include "model/model_set.h"
 #include "model/shape_model.h"
 
 namespace mrsnake {
@@ -20,6 +24,11 @@ constexpr const char* kAppearanceSection = "appearance";
 /// \throw InputError if the model has no levels or a damaged appearance or reference image section.
 SnakeModel snake_model_from(const ShapeModel& model);
 
+/// The SnakeModel of every structure of a model, in its order; each carries the shared
+/// reference crop when the model has one (decoded once), else its own.
+/// \throw InputError as snake_model_from does.
+std::vector<SnakeModel> snake_models_from(const ModelSet& set);
+
 /// Learns the appearance of every level from the reference image (in which the model's
 /// levels lie, in physical coordinates) and stores it in the model's "appearance" section.
 /// \return what was done about the profiles' alignment (AppearanceOptions::alignment).
@@ -32,5 +41,11 @@ ProfileAlignmentReport add_appearance(ShapeModel& model, const Volume& reference
 /// `segment --init register`.
 /// \throw InputError if the image is constant or does not hold the model.
 void add_reference_image(ShapeModel& model, const Volume& reference_image, const ReferenceImageOptions& options = {});
+
+/// The reference_image section's bytes for a crop of `reference_image` around the points
+/// V (every structure's finest level, stacked), normalized by the whole image's robust window.
+/// \throw InputError if the image is constant or does not hold the points.
+std::vector<std::uint8_t> reference_image_section(const Volume& reference_image, const RowMatrixX3d& V,
+                                                  const ReferenceImageOptions& options = {});
 
 }  // namespace mrsnake

@@ -347,8 +347,32 @@ void check_options(const SegmentOptions& options) {
   check_placement_options(options);
 }
 
-SegmentResult segment(const Volume& image, const SnakeModel& model, const SegmentOptions& options,
-                      const ProgressFn& progress) {
+SegmentationImage prepare_segmentation_image(const Volume& image, const SegmentOptions& options,
+                                             const ProgressFn& progress) {
+  const auto t_start = Clock::now();
+  check_options(options);
+  SegmentationImage prepared;
+  StageClock clock(prepared.stage_seconds);
+  report(progress, "normalize", 0.0);
+  prepared.window = robust_intensity_window(image, 1.0, 99.0, options.intensity_samples);
+  clock.end("normalize");
+  report(progress, "pyramid", 0.0);
+  prepared.pyramid = std::make_unique<NormalizedPyramid>(image, prepared.window);
+  clock.end("pyramid");
+  prepared.seconds = seconds_since(t_start);
+  return prepared;
+}
+
+std::optional<ReferenceRegistration> register_structures(const SegmentationImage& image, const SnakeModel& model,
+                                                         const SegmentOptions& options, const ProgressFn& progress) {
+  const InitMode init = resolve_init_mode(options.init, model);
+  if (!registers(init)) return std::nullopt;
+  report(progress, "register", 0.0);
+  return register_model_reference(model, *image.pyramid, init, options.registration, options.moments);
+}
+
+SegmentResult segment(const SegmentationImage& image, const SnakeModel& model, const SegmentOptions& options,
+                      const ProgressFn& progress, const ReferenceRegistration* registration) {
   const auto t_start = Clock::now();
   check_options(options);
   check_model(model, options.force);
@@ -357,15 +381,9 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   SegmentResult result;
   result.force = force.profiles ? "profile" : "step_edge";
   result.profile_step_residual = force.step_residual;
+  result.window = image.window;
   StageClock clock(result.stage_seconds);
-
-  // Image side: robust normalization and the pyramid.
-  report(progress, "normalize", 0.0);
-  result.window = robust_intensity_window(image, 1.0, 99.0, options.intensity_samples);
-  clock.end("normalize");
-  report(progress, "pyramid", 0.0);
-  const NormalizedPyramid pyramid(image, result.window);
-  clock.end("pyramid");
+  const NormalizedPyramid& pyramid = *image.pyramid;
   // Which pyramid level each mesh level runs on, and its search.
   const LevelSearches searches(model, pyramid, force.profiles, level_search_options(options));
 
@@ -373,9 +391,12 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
   report(progress, "initialize", 0.0);
   const InitMode init = resolve_init_mode(options.init, model);
   if (registers(init)) {
-    report(progress, "register", 0.0);
-    result.registration = register_model_reference(model, pyramid, init, options.registration, options.moments);
-    clock.end("register");
+    if (registration != nullptr) {
+      result.registration = *registration;
+    } else {
+      result.registration = register_structures(image, model, options, progress);
+      clock.end("register");
+    }
   }
   InitialPose start = initial_pose(model, pyramid, searches, result.registration, init, initial_pose_options(options));
   result.init = start.init;
@@ -403,6 +424,19 @@ SegmentResult segment(const Volume& image, const SnakeModel& model, const Segmen
     result.self_intersections = count_self_intersections(result.surface);
     clock.end("self_intersections");
   }
+  return result;
+}
+
+SegmentResult segment(const Volume& image, const SnakeModel& model, const SegmentOptions& options,
+                      const ProgressFn& progress) {
+  check_options(options);
+  check_model(model, options.force);
+  const SegmentationImage prepared = prepare_segmentation_image(image, options, progress);
+  SegmentResult result = segment(prepared, model, options, progress);
+  // The image's stages first, as one run of the whole pipeline reports them.
+  result.stage_seconds.insert(result.stage_seconds.begin(), prepared.stage_seconds.begin(),
+                              prepared.stage_seconds.end());
+  result.compute_seconds += prepared.seconds;
   return result;
 }
 

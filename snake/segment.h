@@ -5,6 +5,7 @@
 /// for each level j deform S_j on the matching pyramid level and synthesize S_{j+1} from the
 /// deformed S_j with the model's details. The connectivity never changes.
 #include <functional>
+#include <memory>
 #include <limits>
 #include <optional>
 #include <string>
@@ -263,6 +264,35 @@ void check_options(const SegmentOptions& options);
 /// \throw OptionsError if an option is out of its range (check_options).
 SegmentResult segment(const Volume& image, const SnakeModel& model, const SegmentOptions& options = {},
                       const ProgressFn& progress = {});
+
+/// The image side of a segmentation: the robust intensity window and the normalized pyramid,
+/// made once and shared by every structure of a model.
+struct SegmentationImage {
+  IntensityWindow window;
+  std::unique_ptr<NormalizedPyramid> pyramid;
+  std::vector<std::pair<std::string, double>> stage_seconds;  ///< normalize, pyramid
+  double seconds = 0;
+};
+
+/// \pre image outlives the result (pyramid level 0 may be the image itself).
+/// \throw OptionsError if an option is out of its range (check_options).
+SegmentationImage prepare_segmentation_image(const Volume& image, const SegmentOptions& options = {},
+                                             const ProgressFn& progress = {});
+
+/// The registration of `model`'s reference image to the prepared image, run once for every
+/// structure that shares that reference (segment() with `registration`), when the options'
+/// route registers; std::nullopt otherwise.
+/// \throw InputError if the route registers and the model has no reference image.
+std::optional<ReferenceRegistration> register_structures(const SegmentationImage& image, const SnakeModel& model,
+                                                         const SegmentOptions& options,
+                                                         const ProgressFn& progress = {});
+
+/// segment() on a prepared image. With `registration` (from register_structures), a route
+/// that registers uses it instead of registering again; its seconds are counted once, by the
+/// caller. The result's compute_seconds and stage_seconds cover this structure only.
+/// \throw as segment().
+SegmentResult segment(const SegmentationImage& image, const SnakeModel& model, const SegmentOptions& options,
+                      const ProgressFn& progress = {}, const ReferenceRegistration* registration = nullptr);
 
 /// The report of `mrsnake segment` (timings per stage and level, iterations, convergence,
 /// final energy, self-intersection count).

@@ -54,6 +54,46 @@ std::vector<double> iterations(std::size_t n) {
   return x;
 }
 
+// Every structure's surface as one mesh, each face carrying its structure's label value.
+TriMesh merged_surfaces(const std::vector<PageStructure>& structures, std::vector<double>& face_values) {
+  Eigen::Index nv = 0, nf = 0;
+  for (const PageStructure& s : structures) {
+    nv += s.surface->num_vertices();
+    nf += s.surface->num_faces();
+  }
+  TriMesh all;
+  all.V.resize(nv, 3);
+  all.F.resize(nf, 3);
+  face_values.clear();
+  Eigen::Index v = 0, f = 0;
+  for (const PageStructure& s : structures) {
+    all.V.middleRows(v, s.surface->num_vertices()) = s.surface->V;
+    all.F.middleRows(f, s.surface->num_faces()) = s.surface->F.array() + static_cast<int>(v);
+    v += s.surface->num_vertices();
+    f += s.surface->num_faces();
+    face_values.insert(face_values.end(), s.surface->num_faces(), s.value);
+  }
+  return all;
+}
+
+// The table of a model of several structures: volume, volume against the model, verdict.
+void structures_table(HtmlPage& page, const nlohmann::json& r) {
+  if (!r.is_object() || !r.contains("structures") || r["structures"].size() < 2) return;
+  std::vector<std::vector<std::string>> rows;
+  for (const nlohmann::json& s : r["structures"]) {
+    const auto& c = s["color"];
+    char swatch[160];
+    std::snprintf(swatch, sizeof swatch, "<span style='color:rgb(%d,%d,%d)'>&#9632;</span> ", c[0].get<int>(),
+                  c[1].get<int>(), c[2].get<int>());
+    rows.push_back({text(s["value"]), swatch + escape_html(s["name"].get<std::string>()), text(s["volume_mm3"]),
+                    text(s["volume_ratio_to_model"]),
+                    s.contains("scores") && s["scores"].contains("dice") ? text(s["scores"]["dice"]) : "–",
+                    s["suspect"].get<bool>() ? "suspect" : "ok", escape_html(s["reason"].get<std::string>())});
+  }
+  page.heading("Structures");
+  page.table({"value", "name", "volume (mm³)", "volume / model", "Dice", "verdict", "reason"}, rows);
+}
+
 }  // namespace
 
 std::string segment_report_html(const SegmentPageInput& in) {
@@ -77,23 +117,40 @@ std::string segment_report_html(const SegmentPageInput& in) {
     page.heading("Scores against the truth");
     page.table({"score", "value"}, scores);
   }
+  structures_table(page, r);
 
   // Slices.
   page.heading("Slices");
+  const bool several = in.structures.size() > 1;
   std::vector<LabelContour> label_contours;
-  if (in.truth) label_contours.push_back({in.truth, in.truth_label, {64, 220, 64}, "truth"});
-  page.paragraph(
-      std::string("Three orthogonal slices through the centre of the final surface: the final contour in red") +
-      (in.truth ? ", the truth's outline in green (hidden under the red where the two agree)."
-                : ". (No --truth was given.)"));
+  if (in.truth && !several) label_contours.push_back({in.truth, in.truth_label, {64, 220, 64}, "truth"});
+  std::vector<MeshContour> contours{{in.surface, {255, 64, 64}, "segmentation"}};
+  std::vector<double> face_values;
+  const TriMesh all = several ? merged_surfaces(in.structures, face_values) : TriMesh{};
+  if (several) {
+    contours.clear();
+    for (const PageStructure& s : in.structures)
+      contours.push_back({s.surface,
+                          {static_cast<std::uint8_t>(s.color[0]), static_cast<std::uint8_t>(s.color[1]),
+                           static_cast<std::uint8_t>(s.color[2])},
+                          s.name});
+    page.paragraph(
+        "Three orthogonal slices through the centre of all the structures, each structure's contour in "
+        "its colour (the table above).");
+  } else {
+    page.paragraph(
+        std::string("Three orthogonal slices through the centre of the final surface: the final contour in red") +
+        (in.truth ? ", the truth's outline in green (hidden under the red where the two agree)."
+                  : ". (No --truth was given.)"));
+  }
+  const TriMesh& centred = several ? all : *in.surface;
   page.begin_figures();
   const char* axis_names[] = {"sagittal (x)", "coronal (y)", "axial (z)"};
   std::array<double, 3> centre{};
-  picture(page, "The slice centre", [&] { centre = mesh_centre_index(*in.image, *in.surface); });
+  picture(page, "The slice centre", [&] { centre = mesh_centre_index(*in.image, centred); });
   for (int axis = 0; axis < 3; ++axis)
     picture(page, std::string("The ") + axis_names[axis] + " slice", [&] {
-      const Canvas c = slice_with_contours(*in.image, axis, centre[axis], {{in.surface, {255, 64, 64}, "segmentation"}},
-                                           label_contours, 360);
+      const Canvas c = slice_with_contours(*in.image, axis, centre[axis], contours, label_contours, 360);
       char caption[96];
       std::snprintf(caption, sizeof caption, "%s slice at voxel %.0f", axis_names[axis], std::round(centre[axis]));
       page.png(c.png(), caption);
@@ -107,6 +164,20 @@ std::string segment_report_html(const SegmentPageInput& in) {
   if (!in.renders) why = "3D renders were turned off";
   if (!can_render) {
     page.note("No 3D render of the surface: " + why + ".");
+  } else if (several) {
+    picture(page, "The 3D render", [&] {
+      RenderOptions ro;
+      ro.width = 560;
+      ro.height = 460;
+      ro.wireframe = false;
+      ro.face_scalars = face_values;
+      ro.scalar_title = "label value";
+      page.begin_figures();
+      page.png(render_mesh_png(all, ro), "every structure's surface, coloured by its label value");
+      ro.azimuth += 180;
+      page.png(render_mesh_png(all, ro), "the other side");
+      page.end_figures();
+    });
   } else {
     picture(page, "The 3D render", [&] {
       TriMesh truth_surface;

@@ -6,6 +6,7 @@
 ///
 /// The page takes plain data (no snake types), so the report library stays below the
 /// segmentation in the layers; cmd_segment fills it from SegmentResult and segment_report.
+#include <array>
 #include <string>
 #include <utility>
 #include <vector>
@@ -27,10 +28,21 @@ struct SnakeConvergence {
   bool deformed = true;                    ///< false: finer than the image, only synthesized (no iterations)
 };
 
+/// One structure of a model of several: its final surface, name, label value and colour.
+struct PageStructure {
+  const TriMesh* surface = nullptr;
+  std::string name;
+  int value = 0;
+  std::array<int, 3> color{255, 64, 64};
+};
+
 struct SegmentPageInput {
   std::string title = "mrsnake segment";
-  const Volume* image = nullptr;              ///< the segmented volume (required)
-  const TriMesh* surface = nullptr;           ///< the final surface (required)
+  const Volume* image = nullptr;     ///< the segmented volume (required)
+  const TriMesh* surface = nullptr;  ///< the final surface (required; the first structure's)
+  /// With more than one: every structure's contour in its colour on the slices, one render of
+  /// all the surfaces, and a table of their volumes and verdicts (report["structures"]).
+  std::vector<PageStructure> structures;
   const Volume* truth = nullptr;              ///< optional truth labels on the image's grid
   float truth_label = 1;                      ///< the object's value in *truth
   std::vector<SnakeConvergence> convergence;  ///< per level; empty: the plots say so

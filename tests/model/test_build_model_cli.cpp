@@ -12,6 +12,7 @@
 #include "mesh/image_io.h"
 #include "tests/test_support.h"
 #include "model/model_io.h"
+#include "model/model_set.h"
 
 using namespace mrsnake;
 using namespace mrsnake::test;
@@ -81,7 +82,7 @@ TEST(BuildModelCli, BuildsAModelThatModelInfoAccepts) {
   EXPECT_EQ(stages, (std::vector<std::string>{"read", "marching_cubes", "parameterization", "levels", "analysis",
                                               "label_fit", "report", "write"}));
 
-  const ShapeModel m = load_model(model, {true});
+  const ShapeModel m = load_model_set(model, {true}).structures.at(0).model;
   EXPECT_EQ(m.source_label, 3);
   ASSERT_TRUE(m.physical_frame);
   EXPECT_EQ(m.physical_frame->spacing[2], 1.25);
@@ -129,7 +130,7 @@ TEST(BuildModelCli, BuildsAModelThatModelInfoAccepts) {
   const auto built_halves = run_mrsnake("-q build-model --labels " + labels + " --label 3 -o " + halves +
                                         " --faces 2048" + config_arg(dir, "halves", config));
   ASSERT_EQ(built_halves.exit_code, 0) << built_halves.output;
-  const ShapeModel fitted = load_model(halves, {true});
+  const ShapeModel fitted = load_model_set(halves, {true}).structures.at(0).model;
   EXPECT_EQ(fitted.remesh_quality["parameterization"]["sphere_map"], "two_halves");
   EXPECT_EQ(fitted.remesh_quality["fit_rounds"].get<int>(), 1);
   EXPECT_TRUE(fitted.remesh_quality["per_level"].back().contains("fit"));
@@ -289,7 +290,7 @@ TEST(BuildModelCli, CloseTunnelsMakesAGenusOneLabelModelable) {
   const nlohmann::json summary = nlohmann::json::parse(built.output.substr(built.output.find('{')));
   EXPECT_GE(summary["closing_radius_voxels"].get<int>(), 1);
   EXPECT_LE(summary["closing_radius_voxels"].get<int>(), 6);
-  const ShapeModel m = load_model(model, {true});
+  const ShapeModel m = load_model_set(model, {true}).structures.at(0).model;
   EXPECT_EQ(m.levels(), summary["levels"].get<int>());
 }
 
@@ -324,13 +325,14 @@ TEST(BuildModelCli, LongTubesArePuncturedInTheMiddleAndTheTooLongMappedHierarchi
   const auto summary = nlohmann::json::parse(built.output);
   EXPECT_EQ(summary["faces"], 2048);
   EXPECT_GT(summary["finest_level_quality"]["min_angle_deg"].get<double>(), 25.0);
-  EXPECT_EQ(load_model(model, {true}).remesh_quality["parameterization"]["sphere_map"], "punctured");
+  EXPECT_EQ(load_model_set(model, {true}).structures.at(0).model.remesh_quality["parameterization"]["sphere_map"],
+            "punctured");
   std::filesystem::remove_all(model);
 
   const auto r = run_mrsnake("-q build-model --labels " + write_tube_labels(dir, 100, 2.5) + " --label 1 -o " + model +
                              " --faces 2048" + config_arg(dir, "mc12", {{"surface", {{"mc_spacing_mm", 1.2}}}}));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const ShapeModel long_tube = load_model(model, {true});
+  const ShapeModel long_tube = load_model_set(model, {true}).structures.at(0).model;
   const nlohmann::json& param = long_tube.remesh_quality["parameterization"];
   EXPECT_EQ(param["sphere_map"], "hierarchical");
   EXPECT_NE(param.value("sphere_map_fallback", std::string()).find("orders of magnitude"), std::string::npos) << param;
@@ -357,7 +359,7 @@ TEST(BuildModelCli, ComponentModelsOnePartOfALabelAndRecordsIt) {
       w.output.find("2 connected surfaces; the model uses the largest (--component K models the K-th largest part"),
       std::string::npos)
       << w.output;
-  EXPECT_FALSE(load_model(whole, {true}).source_component.has_value());
+  EXPECT_FALSE(load_model_set(whole, {true}).structures.at(0).model.source_component.has_value());
 
   for (const int part : {1, 2}) {
     const std::string model = (dir / ("part" + std::to_string(part) + ".model")).string();
@@ -365,7 +367,7 @@ TEST(BuildModelCli, ComponentModelsOnePartOfALabelAndRecordsIt) {
                                " -o " + model + " --faces 512");
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_EQ(r.output.find("connected surfaces"), std::string::npos) << r.output;  // one part: nothing dropped
-    const ShapeModel m = load_model(model, {true});
+    const ShapeModel m = load_model_set(model, {true}).structures.at(0).model;
     EXPECT_EQ(m.source_component, part);
     const Eigen::RowVector3d centre = m.level_positions.back().colwise().mean();
     EXPECT_NEAR(centre.x(), part == 1 ? 10.0 : 30.0, 0.5);
@@ -411,7 +413,7 @@ TEST(BuildModelCli, AModelThatLostItsOrganIsRefusedUnlessAllowed) {
   ASSERT_EQ(allowed.exit_code, 0) << allowed.output;
   EXPECT_NE(allowed.output.find("warning: the model's finest level covers its label with Dice "), std::string::npos)
       << allowed.output;
-  const ShapeModel poor = load_model(model, {true});
+  const ShapeModel poor = load_model_set(model, {true}).structures.at(0).model;
   EXPECT_LT(poor.scale["fit_to_label"]["dice"].get<double>(), 0.9);
   std::filesystem::remove_all(model);
 

@@ -532,7 +532,9 @@ TEST(SegmentCommand, InitRegisterReachesTheEndToEndBound) {
   ASSERT_EQ(info.exit_code, 0) << info.output;
   const nlohmann::json mi = nlohmann::json::parse(info.output);
   ASSERT_TRUE(mi["reference_image"].is_object()) << info.output;
-  EXPECT_TRUE(mi["manifest"]["sections"].contains("reference_image"));
+  // The crop is the model's, shared by its structures, not the structure's own section.
+  EXPECT_TRUE(mi["shared_reference_image"].is_object());
+  EXPECT_FALSE(mi["manifest"]["sections"].contains("reference_image"));
 
   const auto s = test::run_mrsnake("segment --image " + d + "/tgt/image.nii.gz --model " + d + "/blob.model -o " + d +
                                    "/seg --init register --truth " + d + "/tgt/truth.nii.gz --json -q");

@@ -410,7 +410,7 @@ TEST(SegmentReal, TheLateralVentriclesWithTheirHornsBuildAModelAndSegment) {
   const auto b = mrsnake::test::run_mrsnake("-q build-model --labels " + labels + " --label 1 --component 1 --image " +
                                             image + " -o " + d + "/ventricles.model");
   ASSERT_EQ(b.exit_code, 0) << b.output;
-  const nlohmann::json model = nlohmann::json::parse(std::ifstream(d + "/ventricles.model/model.json"));
+  const nlohmann::json model = nlohmann::json::parse(std::ifstream(d + "/ventricles.model/structures/1/model.json"));
   EXPECT_EQ(model["remesh_quality"]["parameterization"]["sphere_map"], "hierarchical")
       << model["remesh_quality"]["parameterization"];
   const auto c = mrsnake::test::run_mrsnake("-q synth --from-image " + image + " --from-labels " + labels +
@@ -448,7 +448,7 @@ nlohmann::json segment_blob_at_scale(const std::string& dir, double scale, const
                                             dir + "/seg --truth " + target + "/truth.nii.gz");
   EXPECT_EQ(s.exit_code, 0) << s.output;
   nlohmann::json rep = nlohmann::json::parse(std::ifstream(dir + "/seg/report.json"));
-  rep["model_json"] = nlohmann::json::parse(std::ifstream(model + "/model.json"));
+  rep["model_json"] = nlohmann::json::parse(std::ifstream(model + "/structures/1/model.json"));
   return rep;
 }
 

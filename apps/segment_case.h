@@ -1,0 +1,51 @@
+#pragma once
+/// \file segment_case.h
+/// One image segmented with a model of one or more structures, as `segment` and
+/// `segment-batch` run it: the image prepared and registered once, every structure deformed,
+/// one label map with no voxel claimed twice, a verdict per structure, and the output folder
+/// written atomically.
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "mesh/progress.h"
+#include "model/label_names.h"
+#include "snake/segment.h"
+
+namespace mrsnake::cli {
+
+/// The model as the segmentation uses it.
+struct SegmentModel {
+  std::vector<SnakeModel> structures;
+  std::vector<int> values;          ///< the reference's label value of each structure
+  std::vector<LabelName> labels;    ///< their names and colours
+  std::size_t registering = 0;      ///< the structure whose registration every structure shares: the largest
+  double load_seconds = 0;
+};
+
+/// \throw InputError as load_model_set does.
+SegmentModel load_segment_model(const std::string& path);
+
+/// One image to segment, and where.
+struct SegmentCase {
+  std::string image, truth, output;
+  /// The structure's value in the truth, for a model of one structure (< 0: 1, as synth writes
+  /// it); a model of several is scored on each structure's own value.
+  int truth_label = -1;
+};
+
+struct SegmentCaseOutcome {
+  nlohmann::json report;
+  std::vector<SegmentResult> results;  ///< per structure
+};
+
+/// Segments the case into its output folder (replacing only an earlier result of segment):
+/// labels.nii.gz, surfaces/<value>.vtp, report.json, report.html, and for a model of one
+/// structure also surface.vtp and levels/level_j.vtp.
+/// \throw the errors of reading the inputs, of segment() and of the writes; OutputError if the
+///        output path holds other data.
+SegmentCaseOutcome segment_case(const SegmentCase& c, const SegmentModel& model, const std::string& model_path,
+                                const SegmentOptions& options, double model_load_seconds, const ProgressFn& progress);
+
+}  // namespace mrsnake::cli
