@@ -59,6 +59,23 @@ CaseInputs read_inputs(const SegmentCase& c) {
   return in;
 }
 
+// One structure; if its initialization finds nothing to align to (an image of something
+// else), it is deformed from the model's own pose and its verdict says why, so that one
+// structure cannot stop the others.
+SegmentResult segment_or_flag(const SegmentationImage& image, const SnakeModel& structure, const SegmentOptions& o,
+                              const ProgressFn& progress, const ReferenceRegistration* registration) {
+  try {
+    return segment(image, structure, o, progress, registration);
+  } catch (const AlgorithmError& e) {
+    SegmentOptions at_pose = o;
+    at_pose.init = InitMode::pose;
+    SegmentResult result = segment(image, structure, at_pose, progress);
+    result.registration = registration ? std::optional<ReferenceRegistration>(*registration) : std::nullopt;
+    result.initialization_failure = e.what();
+    return result;
+  }
+}
+
 // Every structure deformed on the image prepared once, from one shared registration.
 std::vector<SegmentResult> segment_structures(const Volume& image, const SegmentModel& model,
                                               const SegmentOptions& options, const ProgressFn& progress,
@@ -74,8 +91,8 @@ std::vector<SegmentResult> segment_structures(const Volume& image, const Segment
   std::vector<SegmentResult> results;
   for (std::size_t i = 0; i < model.structures.size(); ++i) {
     if (!one_structure(model)) report(progress, model.labels[i].name, static_cast<double>(i) / model.structures.size());
-    results.push_back(segment(prepared, model.structures[i], o, one_structure(model) ? progress : ProgressFn{},
-                              registration ? &*registration : nullptr));
+    results.push_back(segment_or_flag(prepared, model.structures[i], o, one_structure(model) ? progress : ProgressFn{},
+                                      registration ? &*registration : nullptr));
   }
   if (registration && !registration->accepted)
     warn("the reference image registration was not used (" + registration->rejection + "); initialized with " +
@@ -165,7 +182,9 @@ nlohmann::json case_report(const SegmentCase& c, const SegmentModel& model, cons
     suspect = true;
     const std::string own = s["reason"].get<std::string>();
     reason += (reason.empty() ? "" : "; ") +
-              (one_structure(model) ? own : s["name"].get<std::string>() + " (" + std::to_string(s["value"].get<int>()) + "): " + own);
+              (one_structure(model)
+                   ? own
+                   : s["name"].get<std::string>() + " (" + std::to_string(s["value"].get<int>()) + "): " + own);
   }
   rep["suspect"] = suspect;
   rep["reason"] = reason;

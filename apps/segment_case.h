@@ -18,9 +18,9 @@ namespace mrsnake::cli {
 /// The model as the segmentation uses it.
 struct SegmentModel {
   std::vector<SnakeModel> structures;
-  std::vector<int> values;          ///< the reference's label value of each structure
-  std::vector<LabelName> labels;    ///< their names and colours
-  std::size_t registering = 0;      ///< the structure whose registration every structure shares: the largest
+  std::vector<int> values;        ///< the reference's label value of each structure
+  std::vector<LabelName> labels;  ///< their names and colours
+  std::size_t registering = 0;    ///< the structure whose registration every structure shares: the largest
   double load_seconds = 0;
 };
 

@@ -48,7 +48,6 @@ fs::path normalized_folder(const std::string& folder) {
   return p;
 }
 
-
 std::vector<std::uint8_t> read_part(const fs::path& dir, const nlohmann::json& entry, const std::string& what) {
   const std::string name = entry.at("path").get<std::string>();
   if (name.empty() || name.find('/') != std::string::npos || name.find('\\') != std::string::npos || name == "." ||
@@ -73,7 +72,6 @@ std::vector<std::uint8_t> read_part(const fs::path& dir, const nlohmann::json& e
                      "' was altered or corrupted (checksum mismatch); rebuild the model");
   return bytes;
 }
-
 
 ReplaceableFolder model_folder() {
   return {[](const fs::path& folder) {

@@ -154,7 +154,8 @@ ModelSet load_model_set(const std::string& folder, const LoadModelOptions& optio
     set.physical_frame = frame_of(m.at("physical_frame"));
     if (m.contains("build_options")) set.build_options = m["build_options"];
     for (const nlohmann::json& s : m.at("skipped"))
-      set.skipped.push_back({s.at("value").get<int>(), s.at("name").get<std::string>(), s.at("reason").get<std::string>()});
+      set.skipped.push_back(
+          {s.at("value").get<int>(), s.at("name").get<std::string>(), s.at("reason").get<std::string>()});
     std::set<int> values;
     for (const nlohmann::json& entry : m.at("structures")) {
       set.structures.push_back(read_structure(dir, entry, folder, options));

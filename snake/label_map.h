@@ -10,9 +10,9 @@ namespace mrsnake {
 
 /// The label map of several closed surfaces on the grid of `grid`, and what it settled.
 struct StructureLabelMap {
-  Volume labels;                 ///< the structure's value inside it, 0 outside every surface
-  std::vector<long> voxels;      ///< per structure, the voxels it holds in `labels`
-  std::vector<long> contested;   ///< per structure, its voxels that another surface also enclosed
+  Volume labels;                ///< the structure's value inside it, 0 outside every surface
+  std::vector<long> voxels;     ///< per structure, the voxels it holds in `labels`
+  std::vector<long> contested;  ///< per structure, its voxels that another surface also enclosed
 };
 
 /// Rasterizes each surface (rasterize_mesh) and writes its value. A voxel inside two or more

@@ -1,9 +1,10 @@
 #pragma once
 /// \file quality_control.h
 /// A verdict on one structure's segmentation from what the run already knows, so that a
-/// result nobody watches is flagged when it is probably wrong: the profile match at the end,
+/// result nobody watches is flagged when it is probably wrong: the match at the end against chance,
 /// the registration, the volume and the shape against the model, the steps the snake had to
 /// reject and the self-intersections it undid.
+#include <optional>
 #include <string>
 
 #include <nlohmann/json_fwd.hpp>
@@ -17,28 +18,36 @@ namespace mrsnake {
 struct QualityControlOptions {
   /// The segmented volume may be this factor off the model's, either way.
   double max_volume_factor = 1.5;
-  /// The mean matched cost of the last deformed level (0: a perfect match; a profile whose
-  /// correlation is below 0.6 costs 0.4 or more).
-  double max_profile_cost = 0.3;
+  /// The final surface's match over the chance match (SegmentResult::final_match_cost over
+  /// chance_match_cost): 1 is a result that matches the image no better than where the
+  /// structure is not.
+  double max_match_ratio = 0.75;
   /// The shape's distance from the model: the RMS of the vertices' residual after the best
   /// similarity onto the model's finest level (same connectivity), over the model's
   /// equivalent radius.
   double max_shape_residual = 0.25;
   /// Vertices moved back to undo self-intersections, as a fraction of the finest level's.
   double max_rolled_back_fraction = 0.05;
+  /// The registered reference crop's normalized cross-correlation with the image
+  /// (ReferenceRegistration::correlation). Between the four mice it is 0.972 to 0.979; a CT
+  /// flipped left to right, registered to its own unflipped crop, gives 0.85.
+  double min_registration_correlation = 0.9;
 };
 
 /// What the verdict is made of, and the verdict.
 struct QualityControl {
-  double volume_ratio = 0;       ///< segmented volume / the model's finest level's
-  double profile_cost = 0;       ///< mean matched cost of the last deformed level
-  double shape_residual = 0;     ///< as QualityControlOptions::max_shape_residual measures it
-  bool registration_used = true; ///< false: the registration was asked for and rejected
-  int rejected_steps = 0;        ///< over every level
-  int rolled_back_vertices = 0;  ///< over every level
-  int self_intersections = -1;   ///< of the final surface (-1: not counted)
+  double volume_ratio = 0;                         ///< segmented volume / the model's finest level's
+  double match_cost = 0;                           ///< SegmentResult::final_match_cost
+  double chance_cost = 0;                          ///< SegmentResult::chance_match_cost
+  double match_ratio = 0;                          ///< match_cost / chance_cost (0 when no level was deformed)
+  double shape_residual = 0;                       ///< as QualityControlOptions::max_shape_residual measures it
+  bool registration_used = true;                   ///< false: the registration was asked for and rejected
+  std::optional<double> registration_correlation;  ///< ReferenceRegistration::correlation, when measured
+  int rejected_steps = 0;                          ///< over every level
+  int rolled_back_vertices = 0;                    ///< over every level
+  int self_intersections = -1;                     ///< of the final surface (-1: not counted)
   bool suspect = false;
-  std::string reason;            ///< every limit passed, "; "-joined; empty when not suspect
+  std::string reason;  ///< every limit passed, "; "-joined; empty when not suspect
 };
 
 /// The verdict on `result` of `model`, whose segmented volume (as the label map holds it)

@@ -10,6 +10,8 @@
 #include "mesh/stage_clock.h"
 #include "mesh/distance.h"
 #include "mesh/errors.h"
+#include "mesh/marching_cubes.h"
+#include "mesh/normals.h"
 #include "mesh/option_checks.h"
 #include "snake/image_pyramid.h"
 #include "snake/level_search.h"
@@ -339,6 +341,33 @@ void check_placement_options(const SegmentOptions& o) {
   check_registration_options(o.registration.itk);
 }
 
+// How well the final surface matches the image, against how well the same search matches
+// where the structure is not: a result that matches no better than chance found no structure
+// (an erased one, an image of another body part, noise that buries the boundary).
+void match_evidence(const LevelSearches& searches, const RegionStats& stats, const LevelOptions& options,
+                    SegmentResult& result) {
+  const auto last =
+      std::find_if(result.levels.rbegin(), result.levels.rend(), [](const LevelOutcome& l) { return l.deformed; });
+  if (last == result.levels.rend()) return;
+  const int j = last->level;
+  const RowMatrixX3d& V = last->surface.V;
+  const RowMatrixX3i& F = last->surface.F;
+  const double range = searches.range_mm(j, options.range_edge_fraction, options.min_range_voxels);
+  const auto [search, step] = searches.search(j, range, stats, nullptr, options.profile_step_fraction);
+  RowMatrixX3d N;
+  vertex_normals(V, F, N);
+  result.final_match_cost = search(V, N).costs.mean();
+  const double radius = std::cbrt(3.0 * std::max(0.0, enclosed_volume(last->surface)) / (4.0 * M_PI));
+  double chance = 0;
+  for (int axis = 0; axis < 3; ++axis)
+    for (const double sign : {-1.0, 1.0}) {
+      RowMatrixX3d moved = V;
+      moved.col(axis).array() += sign * radius;
+      chance += search(moved, N).costs.mean();
+    }
+  result.chance_match_cost = chance / 6.0;
+}
+
 }  // namespace
 
 void check_options(const SegmentOptions& options) {
@@ -363,12 +392,46 @@ SegmentationImage prepare_segmentation_image(const Volume& image, const SegmentO
   return prepared;
 }
 
+namespace {
+
+// The normalized cross-correlation of the reference crop with the image under `pose`.
+double crop_correlation(const Volume& reference, const NormalizedPyramid& pyramid, int level, const Similarity& pose) {
+  const VolumeSampler& sampler = pyramid.samplers[level];
+  const Volume& grid = *pyramid.levels[level];
+  double n = 0, sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
+  for (std::size_t k = 0; k < reference.size[2]; ++k)
+    for (std::size_t j = 0; j < reference.size[1]; ++j)
+      for (std::size_t i = 0; i < reference.size[0]; ++i) {
+        const auto p =
+            reference.index_to_physical(static_cast<double>(i), static_cast<double>(j), static_cast<double>(k));
+        const Eigen::Vector3d idx = sampler.to_index(pose.apply(Eigen::Vector3d(p[0], p[1], p[2])));
+        bool inside = true;
+        for (int a = 0; a < 3; ++a) inside = inside && idx[a] >= 0 && idx[a] <= static_cast<double>(grid.size[a] - 1);
+        if (!inside) continue;
+        const double a = reference.at(i, j, k), b = sampler.value_at_index(idx);
+        n += 1;
+        sa += a;
+        sb += b;
+        saa += a * a;
+        sbb += b * b;
+        sab += a * b;
+      }
+  if (n < 8) return 0.0;
+  const double va = saa - sa * sa / n, vb = sbb - sb * sb / n;
+  return va > 0 && vb > 0 ? (sab - sa * sb / n) / std::sqrt(va * vb) : 0.0;
+}
+
+}  // namespace
+
 std::optional<ReferenceRegistration> register_structures(const SegmentationImage& image, const SnakeModel& model,
                                                          const SegmentOptions& options, const ProgressFn& progress) {
   const InitMode init = resolve_init_mode(options.init, model);
   if (!registers(init)) return std::nullopt;
   report(progress, "register", 0.0);
-  return register_model_reference(model, *image.pyramid, init, options.registration, options.moments);
+  ReferenceRegistration r =
+      register_model_reference(model, *image.pyramid, init, options.registration, options.moments);
+  if (r.accepted) r.correlation = crop_correlation(*model.reference_image, *image.pyramid, r.pyramid_level, r.pose);
+  return r;
 }
 
 SegmentResult segment(const SegmentationImage& image, const SnakeModel& model, const SegmentOptions& options,
@@ -416,6 +479,8 @@ SegmentResult segment(const SegmentationImage& image, const SnakeModel& model, c
   }
   result.stage_seconds.emplace_back("levels", seconds_since(t_levels));
   clock.restart();
+  match_evidence(searches, result.region, level, result);
+  clock.end("match_evidence");
   result.surface = TriMesh{V, model.faces(L)};
   result.compute_seconds = seconds_since(t_start);
   report(progress, "levels", 1.0);
@@ -463,6 +528,7 @@ nlohmann::json segment_report(const SegmentResult& r) {
     const ReferenceRegistration& g = *r.registration;
     nlohmann::json reg{
         {"accepted", g.accepted}, {"ran", g.ran}, {"seconds", g.seconds}, {"pyramid_level", g.pyramid_level}};
+    if (std::isfinite(g.correlation)) reg["correlation"] = g.correlation;
     if (!g.accepted) {
       reg["rejection"] = g.rejection;
       reg["fallback"] = to_string(r.init);

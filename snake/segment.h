@@ -198,6 +198,15 @@ struct SegmentResult {
   /// profile_step_residual of the model's appearance (appearance.h) when the force was
   /// chosen automatically; +infinity otherwise.
   double profile_step_residual = std::numeric_limits<double>::infinity();
+  /// The match at the end against chance (match_evidence in segment.cpp): the mean best cost
+  /// of the last deformed level's search on its final surface, and on that surface moved off
+  /// by its equivalent radius along each axis, both ways (where the image holds nothing of
+  /// the structure). NaN when no level was deformed.
+  double final_match_cost = std::numeric_limits<double>::quiet_NaN();
+  double chance_match_cost = std::numeric_limits<double>::quiet_NaN();
+  /// Why the initialization asked for failed, when the caller fell back on the model's own
+  /// pose (segment_case does, so that one structure cannot stop the others); empty otherwise.
+  std::string initialization_failure;
   std::vector<std::pair<std::string, double>> stage_seconds;
   double compute_seconds = 0;  ///< everything after loading, without the final self-intersection count
 };
