@@ -175,6 +175,9 @@ nlohmann::json case_report(const SegmentCase& c, const SegmentModel& model, cons
   for (const auto& [name, s] : shared_seconds.items()) stages[name] = s;
   rep["stage_seconds"] = stages;
   rep["structures"] = structures;
+  int self_intersections = 0;
+  for (const nlohmann::json& st : structures) self_intersections += st["self_intersections"].get<int>();
+  rep["self_intersections"] = self_intersections;  // over every structure
   std::string reason;
   bool suspect = false;
   for (const nlohmann::json& s : structures) {

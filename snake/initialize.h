@@ -114,11 +114,6 @@ struct ReferenceRegistration {
   Similarity pose;            ///< reference space → new image (the identity when rejected)
   RegistrationResult result;  ///< ITK's outcome (when it ran)
   int pyramid_level = 0;      ///< the level of the new image's pyramid registered to
-  /// Normalized cross-correlation of the reference crop with the new image where the pose
-  /// puts it (on that pyramid level, over the crop's voxels that land inside the image):
-  /// a measure of the alignment that does not depend on the metric or the intensities' scale.
-  /// NaN when it is not measured (segment's register_structures measures it).
-  double correlation = std::numeric_limits<double>::quiet_NaN();
   double seconds = 0;
   /// When the start from the identity was rejected and a second start (the moments'
   /// translation) was tried: the first rejection and that start.

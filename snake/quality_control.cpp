@@ -49,9 +49,12 @@ std::vector<std::string> limits_passed(const QualityControl& qc, const QualityCo
   if (!(qc.shape_residual <= o.max_shape_residual))
     reasons.push_back(fixed("the shape is far from the model's (residual %.2f of its radius, accepted up to %.2f)",
                             qc.shape_residual, o.max_shape_residual));
-  if (qc.registration_correlation && *qc.registration_correlation < o.min_registration_correlation)
-    reasons.push_back(fixed("the registered reference correlates poorly with the image (%.2f, accepted from %.2f)",
-                            *qc.registration_correlation, o.min_registration_correlation));
+  if (qc.registration_correlation && *qc.registration_correlation < o.min_registration_correlation &&
+      qc.match_ratio > o.weak_match_ratio && qc.match_ratio <= o.max_match_ratio)
+    reasons.push_back(
+        fixed3("the registered reference correlates poorly with the image (%.2f, accepted from %.2f) "
+               "and the surface matches it weakly (cost %.2f of chance's)",
+               *qc.registration_correlation, o.min_registration_correlation, qc.match_ratio));
   if (vertices > 0 && qc.rolled_back_vertices > o.max_rolled_back_fraction * vertices)
     reasons.push_back(fixed("%.0f vertices were moved back to undo self-intersections (accepted up to %.0f)",
                             qc.rolled_back_vertices, o.max_rolled_back_fraction * vertices));
@@ -73,8 +76,7 @@ QualityControl assess_segmentation(const SegmentResult& result, const SnakeModel
   }
   qc.shape_residual = shape_residual(result.surface.V, model.levels[L], model_volume);
   qc.registration_used = !result.registration || result.registration->accepted;
-  if (result.registration && std::isfinite(result.registration->correlation))
-    qc.registration_correlation = result.registration->correlation;
+  if (std::isfinite(result.registration_correlation)) qc.registration_correlation = result.registration_correlation;
   for (const LevelOutcome& l : result.levels) {
     qc.rejected_steps += l.snake.rejected_steps;
     qc.rolled_back_vertices += l.rolled_back_vertices;

@@ -394,7 +394,8 @@ SegmentationImage prepare_segmentation_image(const Volume& image, const SegmentO
 
 namespace {
 
-// The normalized cross-correlation of the reference crop with the image under `pose`.
+// The normalized cross-correlation of the reference crop with pyramid level `level` of the
+// image under `pose`.
 double crop_correlation(const Volume& reference, const NormalizedPyramid& pyramid, int level, const Similarity& pose) {
   const VolumeSampler& sampler = pyramid.samplers[level];
   const Volume& grid = *pyramid.levels[level];
@@ -421,6 +422,17 @@ double crop_correlation(const Volume& reference, const NormalizedPyramid& pyrami
   return va > 0 && vb > 0 ? (sab - sa * sb / n) / std::sqrt(va * vb) : 0.0;
 }
 
+// SegmentResult::registration_correlation.
+double registration_correlation(const SnakeModel& model, const NormalizedPyramid& pyramid,
+                                const ReferenceRegistration& registration) {
+  // At twice the registration's scale, where the voxels' noise is averaged out of both.
+  const int level = std::min<int>(registration.pyramid_level + 1, static_cast<int>(pyramid.levels.size()) - 1);
+  const Volume& crop = *model.reference_image;
+  const bool halve =
+      level > registration.pyramid_level && crop.size[0] >= 16 && crop.size[1] >= 16 && crop.size[2] >= 16;
+  return crop_correlation(halve ? downsample_by_two(crop) : crop, pyramid, level, registration.pose);
+}
+
 }  // namespace
 
 std::optional<ReferenceRegistration> register_structures(const SegmentationImage& image, const SnakeModel& model,
@@ -428,10 +440,7 @@ std::optional<ReferenceRegistration> register_structures(const SegmentationImage
   const InitMode init = resolve_init_mode(options.init, model);
   if (!registers(init)) return std::nullopt;
   report(progress, "register", 0.0);
-  ReferenceRegistration r =
-      register_model_reference(model, *image.pyramid, init, options.registration, options.moments);
-  if (r.accepted) r.correlation = crop_correlation(*model.reference_image, *image.pyramid, r.pyramid_level, r.pose);
-  return r;
+  return register_model_reference(model, *image.pyramid, init, options.registration, options.moments);
 }
 
 SegmentResult segment(const SegmentationImage& image, const SnakeModel& model, const SegmentOptions& options,
@@ -480,6 +489,8 @@ SegmentResult segment(const SegmentationImage& image, const SnakeModel& model, c
   result.stage_seconds.emplace_back("levels", seconds_since(t_levels));
   clock.restart();
   match_evidence(searches, result.region, level, result);
+  if (result.registration && result.registration->accepted && model.reference_image)
+    result.registration_correlation = registration_correlation(model, pyramid, *result.registration);
   clock.end("match_evidence");
   result.surface = TriMesh{V, model.faces(L)};
   result.compute_seconds = seconds_since(t_start);
@@ -528,7 +539,6 @@ nlohmann::json segment_report(const SegmentResult& r) {
     const ReferenceRegistration& g = *r.registration;
     nlohmann::json reg{
         {"accepted", g.accepted}, {"ran", g.ran}, {"seconds", g.seconds}, {"pyramid_level", g.pyramid_level}};
-    if (std::isfinite(g.correlation)) reg["correlation"] = g.correlation;
     if (!g.accepted) {
       reg["rejection"] = g.rejection;
       reg["fallback"] = to_string(r.init);

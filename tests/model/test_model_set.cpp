@@ -28,8 +28,8 @@ ShapeModel small_model(double scale) {
 ModelSet two_structures() {
   ModelSet set;
   set.source_image = "atlas-labels.nii.gz";
-  set.structures.push_back({3, {"caudate", {10, 20, 30}}, small_model(1.0)});
-  set.structures.push_back({7, {"thalamus, left", {200, 100, 0}}, small_model(2.0)});
+  set.structures.push_back({3, LabelName{"caudate", {10, 20, 30}}, small_model(1.0)});
+  set.structures.push_back({7, LabelName{"thalamus, left", {200, 100, 0}}, small_model(2.0)});
   set.skipped.push_back({9, "fornix", "label 9 has a genus-2 surface"});
   set.reference_image = {9, 8, 7, 6, 5};
   set.build_options = {{"faces", 0}};
@@ -61,7 +61,8 @@ TEST(ModelSet, SavesAndLoadsEveryStructureWithItsNameAndTheSharedCrop) {
   EXPECT_EQ(set.structures[1].label.name, "thalamus, left");
   EXPECT_EQ(set.structures[1].label.color, (std::array<int, 3>{200, 100, 0}));
   EXPECT_EQ(set.structures[0].model.base, two_structures().structures[0].model.base);  // bit for bit
-  EXPECT_EQ(set.structures[1].model.level_positions.back().rows(), set.structures[0].model.level_positions.back().rows());
+  EXPECT_EQ(set.structures[1].model.level_positions.back().rows(),
+            set.structures[0].model.level_positions.back().rows());
   EXPECT_EQ(set.reference_image, (std::vector<std::uint8_t>{9, 8, 7, 6, 5}));
   ASSERT_EQ(set.skipped.size(), 1u);
   EXPECT_EQ(set.skipped[0].reason, "label 9 has a genus-2 surface");
@@ -113,7 +114,8 @@ TEST(LabelNames, ReadsAnItkSnapDescriptionAndACsvAndRefusesMalformedRows) {
   EXPECT_EQ(snap.at(3).color, (std::array<int, 3>{255, 128, 0}));
   EXPECT_EQ(snap.at(21).name, "Hippocampus (B)");
 
-  write_text(dir / "names.csv", "value,structure,side\n1,Hippocampus,A\n2,\"External capsule, corpus callosum\",both\n");
+  write_text(dir / "names.csv",
+             "value,structure,side\n1,Hippocampus,A\n2,\"External capsule, corpus callosum\",both\n");
   const auto csv = read_label_names((dir / "names.csv").string());
   ASSERT_EQ(csv.size(), 2u);
   EXPECT_EQ(csv.at(2).name, "External capsule, corpus callosum");

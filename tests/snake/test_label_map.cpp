@@ -43,7 +43,7 @@ TEST(StructureLabelMap, TwoOverlappingSpheresSplitTheirOverlapAtTheMiddle) {
         inside_both += in_a && in_b;
         float expected = 0;
         if (in_a && in_b) {
-          if (i == 20) continue;  // the tie plane: either is right
+          if (i == 20) continue;            // the tie plane: either is right
           expected = i < 20 ? 3.0f : 7.0f;  // deeper inside the sphere whose centre is nearer
         } else if (in_a || in_b) {
           expected = in_a ? 3.0f : 7.0f;
