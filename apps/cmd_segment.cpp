@@ -129,9 +129,11 @@ void add_segment_command(CLI::App& app) {
   a->snake.add_to(cmd);
   cmd->add_option("--truth", a->c.truth,
                   "Truth labels on the image's grid: adds the scores of 'mrsnake evaluate' to the report");
-  a->truth_label_flag = cmd->add_option("--truth-label", a->truth_label,
-                                        "Value of the structure in --truth, for a model of one structure (default 1); "
-                                        "a model of several is scored on each structure's own value");
+  a->truth_label_flag =
+      cmd->add_option("--truth-label", a->truth_label,
+                      "Value of the structure in --truth, for a model of one structure (default: its own value "
+                      "when the truth holds it, else 1); a model of several is scored on each "
+                      "structure's own value");
   cmd->add_flag("--json", a->json, "Print the report as JSON on stdout");
   cmd->footer(
       "Example:\n"

@@ -45,6 +45,9 @@ ReplaceableFolder segment_folder() {
 struct CaseInputs {
   Volume image, truth;
   double seconds = 0;
+  bool truth_holds(int value) const {
+    return std::find(truth.data.begin(), truth.data.end(), static_cast<float>(value)) != truth.data.end();
+  }
 };
 
 CaseInputs read_inputs(const SegmentCase& c) {
@@ -144,8 +147,10 @@ nlohmann::json structure_report(const SegmentCase& c, const CaseInputs& in, cons
   rep["suspect"] = qc.suspect;
   rep["reason"] = qc.reason;
   if (!c.truth.empty()) {
-    // A truth of one structure is 1 inside (as synth writes it) unless told; of several, the reference's values.
-    const int truth_label = !one_structure(model) ? value : c.truth_label >= 0 ? c.truth_label : 1;
+    // The structure's own value; a truth without it, of one structure, is 1 inside (as synth writes it).
+    const int truth_label = c.truth_label >= 0                               ? c.truth_label
+                            : !one_structure(model) || in.truth_holds(value) ? value
+                                                                             : 1;
     nlohmann::json scores;
     try {
       to_json(scores, evaluate_segmentation(map.labels, in.truth, value, truth_label));
@@ -219,6 +224,7 @@ void write_page(const fs::path& path, const SegmentCase& c, const CaseInputs& in
     }
     page.convergence.push_back(std::move(conv));
   }
+  if (!one_structure(model)) page.convergence_of = model.labels[0].name + " (" + std::to_string(model.values[0]) + ")";
   page.report = rep;
   reports::write_segment_report(path.string(), page);
 }

@@ -55,6 +55,13 @@ using namespace mrsnake;
 
 namespace {
 
+// A segment output's labels.nii.gz as 1 inside: it holds the structure's reference value.
+Volume read_structure_labels(const fs::path& path) {
+  Volume labels = read_volume(path.string());
+  for (float& v : labels.data) v = v != 0.0f ? 1.0f : 0.0f;
+  return labels;
+}
+
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
@@ -291,7 +298,7 @@ struct Bench {
   SegmentationScores score_in_child(const fs::path& labels, const fs::path& truth, const fs::path& out) {
     const ChildResult r = run_forked([&] {
       json j;
-      to_json(j, evaluate_segmentation(read_volume(labels.string()), read_volume(truth.string())));
+      to_json(j, evaluate_segmentation(read_structure_labels(labels), read_volume(truth.string())));
       std::ofstream(out) << j.dump();
       return 0;
     });
@@ -490,7 +497,7 @@ struct Bench {
         bench::set_itk_threads(1);
         const auto t0 = Clock::now();
         const Volume image = read_volume(c.image.string());
-        const Volume start = read_volume((init / "labels.nii.gz").string());
+        const Volume start = read_structure_labels(init / "labels.nii.gz");
         const double load = seconds_since(t0);
         const bench::LevelSetRun run = method == "itk_gac" ? bench::geodesic_active_contour(image, start, itk_options)
                                                            : bench::threshold_level_set(image, start, itk_options);

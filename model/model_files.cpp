@@ -73,6 +73,14 @@ std::vector<std::uint8_t> read_part(const fs::path& dir, const nlohmann::json& e
   return bytes;
 }
 
+std::string writable_model_path(const std::string& folder) {
+  const fs::path final_path = normalized_folder(folder);
+  if (final_path.empty()) throw OutputError("empty model folder name; give a path such as brain.model");
+  const fs::path parent = final_path.has_parent_path() ? final_path.parent_path() : fs::path(".");
+  ensure_writable_directory(parent.string());
+  return final_path.string();
+}
+
 ReplaceableFolder model_folder() {
   return {[](const fs::path& folder) {
             std::error_code ec;

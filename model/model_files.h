@@ -39,6 +39,10 @@ std::filesystem::path normalized_folder(const std::string& folder);
 std::vector<std::uint8_t> read_part(const std::filesystem::path& dir, const nlohmann::json& entry,
                                     const std::string& what);
 
+/// The folder's normalized path, its parent folder created if needed.
+/// \throw OutputError if the name is empty or the parent cannot be written.
+std::string writable_model_path(const std::string& folder);
+
 /// What a model may replace: a model folder (with its manifest) or an empty one.
 ReplaceableFolder model_folder();
 

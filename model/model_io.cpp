@@ -158,13 +158,10 @@ void save_model(const std::string& folder, const ShapeModel& model, const Progre
       throw std::invalid_argument("save_model: invalid section name '" + name + "' (use [a-z0-9_]+, not 'details')");
   const SubdivisionConnectivity conn = model.connectivity();
 
-  const fs::path final_path = normalized_folder(folder);
-  if (final_path.empty()) throw OutputError("empty model folder name; give a path such as liver.model");
-  const fs::path parent = final_path.has_parent_path() ? final_path.parent_path() : fs::path(".");
-  ensure_writable_directory(parent.string());
+  const std::string final_path = writable_model_path(folder);
   // Written into a temporary folder beside the final one, renamed into place at the end
   // (and removed on an error or an interrupt). Only a model folder is replaced.
-  AtomicDirectory out(final_path.string(), model_folder());
+  AtomicDirectory out(final_path, model_folder());
   const fs::path temp = out.temp_path();
 
   report(progress, "write model", 0.0);

@@ -116,11 +116,8 @@ ModelSet read_single_structure(const std::string& folder, const LoadModelOptions
 void save_model_set(const std::string& folder, const ModelSet& set, const ProgressFn& progress,
                     const std::function<void(const std::string& temp_folder)>& write_extras) {
   check_writable(set);
-  const fs::path final_path = normalized_folder(folder);
-  if (final_path.empty()) throw OutputError("empty model folder name; give a path such as brain.model");
-  const fs::path parent = final_path.has_parent_path() ? final_path.parent_path() : fs::path(".");
-  ensure_writable_directory(parent.string());
-  AtomicDirectory out(final_path.string(), model_folder());
+  const std::string final_path = writable_model_path(folder);
+  AtomicDirectory out(final_path, model_folder());
   const fs::path temp = out.temp_path();
 
   nlohmann::json m;

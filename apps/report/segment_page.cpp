@@ -205,7 +205,9 @@ std::string segment_report_html(const SegmentPageInput& in) {
   } else {
     page.paragraph(
         "Energy (mean matched cost plus the internal term) and the mean |matched offset| along the normals "
-        "at each iteration of each level.");
+        "at each iteration of each level" +
+        (in.convergence_of.empty() ? std::string(".")
+                                   : " of " + in.convergence_of + "; report.json holds every structure's levels."));
     page.begin_figures();
     for (const SnakeConvergence& c : in.convergence) {
       if (!c.deformed) {

@@ -46,6 +46,8 @@ struct SegmentPageInput {
   const Volume* truth = nullptr;              ///< optional truth labels on the image's grid
   float truth_label = 1;                      ///< the object's value in *truth
   std::vector<SnakeConvergence> convergence;  ///< per level; empty: the plots say so
+  /// With several structures: the name of the one whose convergence is shown.
+  std::string convergence_of;
   /// segment_report's JSON (levels, scores, stage_seconds, initial_pose, ...), shown as tables.
   nlohmann::json report;
   /// Renders are attempted only when reports::display_available(); set false to never try.

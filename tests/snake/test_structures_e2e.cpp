@@ -39,9 +39,12 @@ Volume scene_labels(double shift, double grow) {
           return a * a + b * b + c * c <= 1.0;
         };
         const double ring = std::hypot(std::hypot(x - 32, z - 30) - 7.0, y - 38);
-        if (e(17, 20, 17, 11, 8, 7)) v.at(i, j, k) = 3;
-        else if (e(46, 19, 18, 7, 9, 6)) v.at(i, j, k) = 7;
-        else if (ring <= 2.5) v.at(i, j, k) = 9;
+        if (e(17, 20, 17, 11, 8, 7))
+          v.at(i, j, k) = 3;
+        else if (e(46, 19, 18, 7, 9, 6))
+          v.at(i, j, k) = 7;
+        else if (ring <= 2.5)
+          v.at(i, j, k) = 9;
       }
   return v;
 }
@@ -120,8 +123,7 @@ TEST(Structures, AllLabelsBuildOneModelAndSegmentIntoOneLabelMap) {
   EXPECT_NE(mi["skipped"][0]["reason"].get<std::string>().find("genus"), std::string::npos) << mi["skipped"];
   EXPECT_TRUE(mi["shared_reference_image"].is_object());
 
-  const nlohmann::json rep =
-      segment_json(d + "/target.nii.gz", d + "/seg", " --truth " + d + "/target_labels.nii.gz");
+  const nlohmann::json rep = segment_json(d + "/target.nii.gz", d + "/seg", " --truth " + d + "/target_labels.nii.gz");
   ASSERT_TRUE(rep.is_object());
   EXPECT_FALSE(rep["suspect"].get<bool>()) << rep["reason"];
   for (const int value : {3, 7}) {
@@ -182,8 +184,8 @@ TEST(StructuresReal, ABrainModelOnTheAbdominalCtIsFlagged) {
   MRSNAKE_REQUIRE_DATA(ct, "volumes/abdomen-ct-small.nii.gz");
   const fs::path dir = test::scratch_dir("structures-brain-on-ct");
   const std::string model = (dir / "hippocampi.model").string();
-  const auto b = run_mrsnake("-q build-model --labels " + mouse_labels + " --label 1,21 --image " + mouse_image +
-                             " -o " + model);
+  const auto b =
+      run_mrsnake("-q build-model --labels " + mouse_labels + " --label 1,21 --image " + mouse_image + " -o " + model);
   ASSERT_EQ(b.exit_code, 0) << b.output;
   const auto s = run_mrsnake("-q segment --image " + ct + " --model " + model + " -o " + (dir / "seg").string());
   ASSERT_EQ(s.exit_code, 0) << s.output;  // flagged, not refused: the batch keeps its record
@@ -207,7 +209,8 @@ TEST(StructuresReal, ALiverModelOnTheCtFlippedLeftToRightIsFlagged) {
       for (std::size_t i = 0; i < flipped.size[0]; ++i)
         flipped.at(i, j, k) = original.at(flipped.size[0] - 1 - i, j, k);
   write_volume((dir / "flipped.nii.gz").string(), flipped, VoxelType::float32);
-  for (const auto& [image, suspect] : {std::pair<std::string, bool>{ct, false}, {(dir / "flipped.nii.gz").string(), true}}) {
+  for (const auto& [image, suspect] :
+       {std::pair<std::string, bool>{ct, false}, {(dir / "flipped.nii.gz").string(), true}}) {
     const auto s = run_mrsnake("-q segment --image " + image + " --model " + model + " -o " + (dir / "seg").string());
     ASSERT_EQ(s.exit_code, 0) << s.output;
     const nlohmann::json rep = nlohmann::json::parse(std::ifstream(dir / "seg" / "report.json"));
