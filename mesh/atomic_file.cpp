@@ -1,6 +1,7 @@
 #include "mesh/atomic_file.h"
 
-#include <dirent.h>
+#include <fcntl.h>
+#include <sys/syscall.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -45,23 +46,48 @@ void unregister_temp(int slot) {
   g_used[slot] = 0;
 }
 
-// Removes a file or a folder tree with plain system calls (usable from a signal handler).
+// `dir` + "/" + `name` into `out` (kMaxPath bytes) without the C library's formatting.
+bool join_path(const char* dir, const char* name, char* out) {
+  const std::size_t a = std::strlen(dir), b = std::strlen(name);
+  if (a + 1 + b >= static_cast<std::size_t>(kMaxPath)) return false;
+  std::memcpy(out, dir, a);
+  out[a] = '/';
+  std::memcpy(out + a + 1, name, b + 1);
+  return true;
+}
+
+// The entries getdents64 returns, as the kernel lays them out.
+struct KernelDirent {
+  ino64_t inode;
+  off64_t offset;
+  unsigned short length;
+  unsigned char type;
+  char name[1];
+};
+
+// Removes a file or a folder tree with system calls only: it runs in the signal handler, which
+// may have interrupted malloc, so nothing here may allocate (opendir does).
 void remove_tree(const char* path) {
   struct stat st;
   if (lstat(path, &st) != 0) return;
-  if (S_ISDIR(st.st_mode)) {
-    if (DIR* dir = opendir(path)) {
-      while (dirent* e = readdir(dir)) {
-        if (!std::strcmp(e->d_name, ".") || !std::strcmp(e->d_name, "..")) continue;
-        char child[kMaxPath];
-        const int n = snprintf(child, sizeof child, "%s/%s", path, e->d_name);
-        if (n > 0 && n < kMaxPath) remove_tree(child);
-      }
-      closedir(dir);
-    }
-    rmdir(path);
-  } else {
+  if (!S_ISDIR(st.st_mode)) {
     unlink(path);
+    return;
+  }
+  // Entries removed while the folder is read may hide others: read it again until it is empty.
+  for (int pass = 0; pass < 8 && rmdir(path) != 0; ++pass) {
+    const int fd = open(path, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0) return;
+    alignas(KernelDirent) char buffer[4096];
+    for (long n; (n = syscall(SYS_getdents64, fd, buffer, sizeof buffer)) > 0;)
+      for (long at = 0; at < n;) {
+        const auto* e = reinterpret_cast<const KernelDirent*>(buffer + at);
+        at += e->length;
+        if (!std::strcmp(e->name, ".") || !std::strcmp(e->name, "..")) continue;
+        char child[kMaxPath];
+        if (join_path(path, e->name, child)) remove_tree(child);
+      }
+    close(fd);
   }
 }
 
