@@ -212,16 +212,14 @@ std::string index_page(const BuildModelArgs& a, const BuiltModelSet& set) {
     row.emplace_back(text);
     std::snprintf(text, sizeof text, "%.4f", s.built.fit.dice);
     row.emplace_back(text);
-    row.push_back("<a href='structures/" + std::to_string(s.value) + "/report.html'>page</a>");
+    row.push_back("structures/" + std::to_string(s.value) + "/report.html");
     rows.push_back(std::move(row));
   }
   page.heading("Structures");
-  page.table({"value", "name", "levels", "faces", "volume mm3", "fit Dice", "report"}, rows);
+  page.table({"value", "name", "levels", "faces", "volume mm3", "fit Dice", "its page"}, rows);
   if (!set.skipped.empty()) {
     std::vector<std::vector<std::string>> skipped;
-    for (const SkippedLabel& k : set.skipped)
-      skipped.push_back(
-          {std::to_string(k.value), mrsnake::reports::escape_html(k.name), mrsnake::reports::escape_html(k.reason)});
+    for (const SkippedLabel& k : set.skipped) skipped.push_back({std::to_string(k.value), k.name, k.reason});
     page.heading("Skipped labels");
     page.table({"value", "name", "reason"}, skipped);
   }

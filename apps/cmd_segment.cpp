@@ -254,14 +254,15 @@ std::string csv_number(const nlohmann::json& value) {
   return text;
 }
 
-// The structures of the batch's rows, by value, in their order: one column each.
+// The structures of the batch's rows, in increasing value: one column each.
 std::vector<std::string> structure_columns(const nlohmann::json& cases) {
-  std::vector<std::string> values;
+  std::set<int> values;
   for (const auto& c : cases)
     if (c.contains("structures"))
-      for (const auto& [value, s] : c["structures"].items())
-        if (std::find(values.begin(), values.end(), value) == values.end()) values.push_back(value);
-  return values;
+      for (const auto& [value, s] : c["structures"].items()) values.insert(std::stoi(value));
+  std::vector<std::string> columns;
+  for (const int v : values) columns.push_back(std::to_string(v));
+  return columns;
 }
 
 // One row's volume and verdict of each structure column.

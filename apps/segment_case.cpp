@@ -175,6 +175,7 @@ nlohmann::json case_report(const SegmentCase& c, const SegmentModel& model, cons
   rep["options"] = options;  // as given: what --config reads
   if (!c.truth.empty()) rep["truth"] = c.truth;
   if (structures[0].contains("registration")) rep["registration"] = structures[0]["registration"];
+  rep["init_used"] = structures[model.registering]["init_used"];  // the route of the shared registration
   rep["compute_seconds"] = compute_seconds;
   nlohmann::json stages = one_structure(model) ? structures[0]["stage_seconds"] : nlohmann::json::object();
   for (const auto& [name, s] : shared_seconds.items()) stages[name] = s;

@@ -75,7 +75,7 @@ void remove_tree(const char* path) {
     return;
   }
   // Entries removed while the folder is read may hide others: read it again until it is empty.
-  for (int pass = 0; pass < 8 && rmdir(path) != 0; ++pass) {
+  for (int pass = 0; rmdir(path) != 0 && pass < 8; ++pass) {
     const int fd = open(path, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (fd < 0) return;
     alignas(KernelDirent) char buffer[4096];

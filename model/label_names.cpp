@@ -60,8 +60,9 @@ bool parse_itksnap_row(const std::string& line, int& value, LabelName& label) {
     if (!(numbers >> f)) return false;
   std::string rest;
   if (numbers >> rest) return false;
+  if (!(fields[0] >= 0 && fields[0] <= 32767)) return false;
   value = static_cast<int>(fields[0]);
-  if (fields[0] != value || value < 0) return false;
+  if (fields[0] != value) return false;
   for (int c = 0; c < 3; ++c) {
     if (!(fields[1 + c] >= 0 && fields[1 + c] <= 255)) return false;
     label.color[c] = static_cast<int>(fields[1 + c]);

@@ -82,16 +82,14 @@ void structures_table(HtmlPage& page, const nlohmann::json& r) {
   std::vector<std::vector<std::string>> rows;
   for (const nlohmann::json& s : r["structures"]) {
     const auto& c = s["color"];
-    char swatch[160];
-    std::snprintf(swatch, sizeof swatch, "<span style='color:rgb(%d,%d,%d)'>&#9632;</span> ", c[0].get<int>(),
-                  c[1].get<int>(), c[2].get<int>());
-    rows.push_back({text(s["value"]), swatch + escape_html(s["name"].get<std::string>()), text(s["volume_mm3"]),
+    rows.push_back({text(s["value"]), s["name"].get<std::string>(),
+                    "rgb(" + text(c[0]) + ", " + text(c[1]) + ", " + text(c[2]) + ")", text(s["volume_mm3"]),
                     text(s["volume_ratio_to_model"]),
                     s.contains("scores") && s["scores"].contains("dice") ? text(s["scores"]["dice"]) : "–",
-                    s["suspect"].get<bool>() ? "suspect" : "ok", escape_html(s["reason"].get<std::string>())});
+                    s["suspect"].get<bool>() ? "suspect" : "ok", s["reason"].get<std::string>()});
   }
   page.heading("Structures");
-  page.table({"value", "name", "volume (mm³)", "volume / model", "Dice", "verdict", "reason"}, rows);
+  page.table({"value", "name", "colour", "volume (mm³)", "volume / model", "Dice", "verdict", "reason"}, rows);
 }
 
 }  // namespace
