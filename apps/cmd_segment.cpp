@@ -102,7 +102,7 @@ void print_case_summary(const SegmentCase& c, const SegmentModel& model, const S
     }
     info(text);
   }
-  info("wrote " + c.output + "/{labels.nii.gz, surfaces/, report.json, report.html" +
+  info("wrote " + c.output + "/{labels.nii.gz, surfaces/, report.json, report.html, slices.png" +
        (model.structures.size() == 1 ? std::string(", surface.vtp, levels/}") : std::string("}")));
 }
 
@@ -124,7 +124,7 @@ void add_segment_command(CLI::App& app) {
   cmd->add_option("--model", a->model, "Shape model folder (made by 'mrsnake build-model')")->required();
   cmd->add_option("-o,--output", a->c.output,
                   "Output folder: labels.nii.gz (the reference's label values), surfaces/VALUE.vtp, report.json, "
-                  "report.html; for a model of one structure also surface.vtp and levels/level_j.vtp")
+                  "report.html, slices.png; for a model of one structure also surface.vtp and levels/level_j.vtp")
       ->required();
   a->snake.add_to(cmd);
   cmd->add_option("--truth", a->c.truth,
@@ -281,7 +281,7 @@ std::string batch_csv(const nlohmann::json& cases) {
   const std::vector<std::string> values = structure_columns(cases);
   std::string csv =
       "image,output,status,volume_mm3,compute_seconds,load_seconds,wall_seconds,self_intersections,init_used,"
-      "registration,suspect,reason,error";
+      "registration,suspect,reason,error,resumed";
   for (const std::string& v : values) csv += ",volume_mm3_" + v + ",suspect_" + v;
   csv += "\n";
   for (const auto& c : cases) {
@@ -292,8 +292,8 @@ std::string batch_csv(const nlohmann::json& cases) {
            (c.contains("self_intersections") ? csv_number(c["self_intersections"]) : std::string()) + "," +
            csv_field(c.value("init_used", std::string())) + "," + csv_field(c.value("registration", std::string())) +
            "," + (c.contains("suspect") ? std::string(c["suspect"].get<bool>() ? "true" : "false") : std::string()) +
-           "," + csv_field(c.value("reason", std::string())) + "," + csv_field(c.value("error", std::string())) +
-           structure_fields(c, values) + "\n";
+           "," + csv_field(c.value("reason", std::string())) + "," + csv_field(c.value("error", std::string())) + "," +
+           (c.value("resumed", false) ? "true" : "false") + structure_fields(c, values) + "\n";
   }
   return csv;
 }
@@ -316,37 +316,50 @@ std::vector<std::string> read_image_list(const std::string& list) {
   return images;
 }
 
-// One image of a batch: its row of batch.json. The image's own failures are recorded in the
-// row, not thrown: the batch goes on.
+// The fields of a batch.json row that come from the image's report.json.
+void fill_row_from_report(nlohmann::json& row, const nlohmann::json& rep) {
+  row["status"] = "ok";
+  row["volume_mm3"] = rep.value("volume_mm3", nlohmann::json());
+  row["compute_seconds"] = rep["compute_seconds"];
+  row["load_seconds"] = rep["stage_seconds"]["load"];
+  row["self_intersections"] = rep["self_intersections"];
+  row["init_used"] = rep.value("init_used", std::string());
+  row["suspect"] = rep["suspect"];
+  row["reason"] = rep["reason"];
+  nlohmann::json volumes = nlohmann::json::object();
+  for (const nlohmann::json& s : rep["structures"])
+    volumes[std::to_string(s["value"].get<int>())] = {
+        {"name", s["name"]}, {"volume_mm3", s["volume_mm3"]}, {"suspect", s["suspect"]}};
+  row["structures"] = volumes;
+  if (rep.contains("registration"))
+    row["registration"] = rep["registration"].value("accepted", false) ? "accepted" : "rejected";
+}
+
+// One image of a batch: its row of batch.json. With `resume`, an earlier complete result
+// made from the same image, model and options is kept ("resumed": true). The image's own
+// failures are recorded in the row, not thrown: the batch goes on.
 nlohmann::json batch_row(const std::string& image, const std::string& output, const SegmentModel& model,
-                         const std::string& model_path, const SegmentOptions& options, const ProgressFn& progress) {
+                         const std::string& model_path, const SegmentOptions& options, bool resume,
+                         const ProgressFn& progress) {
   const auto t_case = std::chrono::steady_clock::now();
-  nlohmann::json row = {{"image", image}, {"output", output}};
+  nlohmann::json row = {{"image", image}, {"output", output}, {"resumed", false}};
   const auto failed = [&](const std::string& error, ExitCode code) {
     row["status"] = "failed";
     row["error"] = error;
     row["exit_code"] = static_cast<int>(code);
   };
   try {
-    SegmentCase c;
-    c.image = image;
-    c.output = output;
-    const nlohmann::json rep = segment_case(c, model, model_path, options, 0.0, progress).report;
-    row["status"] = "ok";
-    row["volume_mm3"] = rep.value("volume_mm3", nlohmann::json());
-    row["compute_seconds"] = rep["compute_seconds"];
-    row["load_seconds"] = rep["stage_seconds"]["load"];
-    row["self_intersections"] = rep["self_intersections"];
-    row["init_used"] = rep.value("init_used", std::string());
-    row["suspect"] = rep["suspect"];
-    row["reason"] = rep["reason"];
-    nlohmann::json volumes = nlohmann::json::object();
-    for (const nlohmann::json& s : rep["structures"])
-      volumes[std::to_string(s["value"].get<int>())] = {
-          {"name", s["name"]}, {"volume_mm3", s["volume_mm3"]}, {"suspect", s["suspect"]}};
-    row["structures"] = volumes;
-    if (rep.contains("registration"))
-      row["registration"] = rep["registration"].value("accepted", false) ? "accepted" : "rejected";
+    nlohmann::json earlier;
+    if (resume) earlier = reusable_result(output, model, case_fingerprint(image, model, options));
+    if (!earlier.is_null()) {
+      fill_row_from_report(row, earlier);
+      row["resumed"] = true;
+    } else {
+      SegmentCase c;
+      c.image = image;
+      c.output = output;
+      fill_row_from_report(row, segment_case(c, model, model_path, options, 0.0, progress).report);
+    }
   } catch (const Error& e) {
     failed(message_with_hint(e, "segment-batch"), exit_code_of(e));
   } catch (const std::bad_alloc&) {
@@ -369,7 +382,7 @@ void add_segment_batch_command(CLI::App& app) {
     std::string model, output, list;
     SnakeArgs snake;
     int jobs = 1;
-    bool json = false;
+    bool json = false, resume = false;
   };
   auto a = std::make_shared<Args>();
   cmd->add_option("images", a->images, "Volumes to segment (.nii.gz .nrrd .mha ..., or DICOM folders)");
@@ -384,6 +397,9 @@ void add_segment_batch_command(CLI::App& app) {
                   "Images segmented at once, each in a worker process of its own (default 1; the cores: " +
                       std::to_string(std::max(1u, std::thread::hardware_concurrency())) + ")")
       ->check(CLI::Range(1, 256));
+  cmd->add_flag("--resume", a->resume,
+                "Keep each earlier result in DIR that is complete and was made from the same image, model and "
+                "options (by content, as report.json's fingerprint records them); segment the others");
   cmd->add_flag("--json", a->json, "Print the summary (batch.json) on stdout");
   cmd->footer(
       "Example:\n"
@@ -419,7 +435,8 @@ void add_segment_batch_command(CLI::App& app) {
       const std::string name = std::filesystem::path(outputs[i]).filename().string();
       if (row["status"] == "ok") {
         char line[200];
-        std::snprintf(line, sizeof line, "%s%s: %.3f s of compute, %zu structure%s", position.c_str(), name.c_str(),
+        std::snprintf(line, sizeof line, "%s%s: %s%.3f s of compute, %zu structure%s", position.c_str(), name.c_str(),
+                      row["resumed"].get<bool>() ? "kept from an earlier run, " : "",
                       row["compute_seconds"].get<double>(), row["structures"].size(),
                       row["structures"].size() == 1 ? "" : "s");
         std::string text = line;
@@ -442,16 +459,21 @@ void add_segment_batch_command(CLI::App& app) {
         if (!r.is_null()) summary["cases"].push_back(r);
       summary["succeeded"] = finished - failed;
       summary["failed"] = failed;
+      int resumed = 0;
+      for (const nlohmann::json& r : summary["cases"]) resumed += r.value("resumed", false) ? 1 : 0;
+      summary["resumed"] = resumed;
       summary["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_batch).count();
       write_text_file_atomically((dir / "batch.json").string(), json_text(summary, 2) + "\n");
       write_text_file_atomically((dir / "batch.csv").string(), batch_csv(summary["cases"]));
     };
     if (a->jobs > 1 && images.size() > 1) {
-      const auto row = [&](std::size_t i) { return batch_row(images[i], outputs[i], model, a->model, options, {}); };
+      const auto row = [&](std::size_t i) {
+        return batch_row(images[i], outputs[i], model, a->model, options, a->resume, {});
+      };
       run_batch_in_processes(a->jobs, images, outputs, row, done);
     } else {
       for (std::size_t i = 0; i < images.size(); ++i)
-        done(i, batch_row(images[i], outputs[i], model, a->model, options, terminal_progress()));
+        done(i, batch_row(images[i], outputs[i], model, a->model, options, a->resume, terminal_progress()));
     }
     if (a->json) print_json(summary);
     std::vector<double> compute;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 
 #include "apps/cli.h"
 #include "apps/report/segment_page.h"
@@ -36,7 +37,7 @@ ReplaceableFolder segment_folder() {
   return folder_of_entries(
       [](const std::string& name) {
         return name == "surface.vtp" || name == "labels.nii.gz" || name == "levels" || name == "surfaces" ||
-               name == "report.json" || name == "report.html";
+               name == "report.json" || name == "report.html" || name == "slices.png";
       },
       "an output of mrsnake segment");
 }
@@ -167,10 +168,12 @@ nlohmann::json structure_report(const SegmentCase& c, const CaseInputs& in, cons
 // A model of one structure also keeps that structure's keys at the top, as before.
 nlohmann::json case_report(const SegmentCase& c, const SegmentModel& model, const std::string& model_path,
                            const SegmentOptions& options, const std::vector<nlohmann::json>& structures,
-                           const nlohmann::json& shared_seconds, double compute_seconds) {
+                           const nlohmann::json& shared_seconds, double compute_seconds,
+                           const CaseFingerprint& fingerprint) {
   nlohmann::json rep = one_structure(model) ? structures[0] : nlohmann::json::object();
   rep["image"] = c.image;
   rep["model"] = model_path;
+  rep["fingerprint"] = fingerprint;
   rep["init"] = to_string(options.init);
   rep["options"] = options;  // as given: what --config reads
   if (!c.truth.empty()) rep["truth"] = c.truth;
@@ -200,9 +203,9 @@ nlohmann::json case_report(const SegmentCase& c, const SegmentModel& model, cons
   return rep;
 }
 
-// report.html: slices with every structure's contour, a render, convergence, the tables.
-void write_page(const fs::path& path, const SegmentCase& c, const CaseInputs& in, const SegmentModel& model,
-                const std::vector<SegmentResult>& results, const nlohmann::json& rep) {
+// report.html and slices.png: slices with every structure's contour, a render, convergence, the tables.
+void write_pages(const fs::path& dir, const SegmentCase& c, const CaseInputs& in, const SegmentModel& model,
+                 const std::vector<SegmentResult>& results, const nlohmann::json& rep) {
   reports::SegmentPageInput page;
   page.title = "mrsnake segment " + fs::path(c.image).filename().string();
   page.image = &in.image;
@@ -227,7 +230,13 @@ void write_page(const fs::path& path, const SegmentCase& c, const CaseInputs& in
   }
   if (!one_structure(model)) page.convergence_of = model.labels[0].name + " (" + std::to_string(model.values[0]) + ")";
   page.report = rep;
-  reports::write_segment_report(path.string(), page);
+  reports::write_segment_report((dir / "report.html").string(), page);
+  try {
+    const std::vector<std::uint8_t> png = reports::slices_png(page);
+    write_text_file_atomically((dir / "slices.png").string(), std::string(png.begin(), png.end()));
+  } catch (const Error& e) {  // a picture for people: its failure does not fail the segmentation
+    warn(std::string("slices.png was not written: ") + e.what());
+  }
 }
 
 // The meshes and report.json into `dir`.
@@ -261,7 +270,7 @@ void write_outputs(const SegmentCase& c, const CaseInputs& in, const SegmentMode
                        [&] { write_volume((dir / "labels.nii.gz").string(), map.labels, label_voxel_type(model)); });
   // After the join: the page's render forks a child, which must not start while another
   // thread may hold a lock (the allocator's, the loader's) that the child would then wait on.
-  write_page(dir / "report.html", c, in, model, results, rep);
+  write_pages(dir, c, in, model, results, rep);
   out.commit();
   report(progress, "done", 1.0);
 }
@@ -284,8 +293,33 @@ SegmentModel load_segment_model(const std::string& path) {
       model.registering = i;
     }
   }
+  model.fingerprint = model_fingerprint(path);
   model.load_seconds = seconds_since(t);
   return model;
+}
+
+CaseFingerprint case_fingerprint(const std::string& image, const SegmentModel& model, const SegmentOptions& options) {
+  return {image_fingerprint(image), model.fingerprint, options_fingerprint(options), MRSNAKE_VERSION};
+}
+
+nlohmann::json reusable_result(const std::string& output, const SegmentModel& model, const CaseFingerprint& expected) {
+  const fs::path dir(output);
+  std::vector<fs::path> files{"labels.nii.gz", "report.json", "report.html", "slices.png"};
+  for (const int value : model.values) files.push_back(fs::path("surfaces") / (std::to_string(value) + ".vtp"));
+  if (one_structure(model)) files.push_back("surface.vtp");
+  std::error_code ec;
+  for (const fs::path& f : files)
+    if (!fs::is_regular_file(dir / f, ec)) return nullptr;
+  nlohmann::json rep;
+  try {
+    std::ifstream in(dir / "report.json");
+    rep = nlohmann::json::parse(in);
+  } catch (const std::exception&) {  // unreadable or cut short: made again
+    return nullptr;
+  }
+  if (!rep.is_object() || !(fingerprint_from_json(rep.value("fingerprint", nlohmann::json())) == expected))
+    return nullptr;
+  return rep;
 }
 
 SegmentCaseOutcome segment_case(const SegmentCase& c, const SegmentModel& model, const std::string& model_path,
@@ -304,7 +338,8 @@ SegmentCaseOutcome segment_case(const SegmentCase& c, const SegmentModel& model,
   std::vector<nlohmann::json> structures;
   for (std::size_t i = 0; i < model.structures.size(); ++i)
     structures.push_back(structure_report(c, in, model, i, outcome.results[i], map));
-  outcome.report = case_report(c, model, model_path, options, structures, shared_seconds, compute_seconds);
+  outcome.report = case_report(c, model, model_path, options, structures, shared_seconds, compute_seconds,
+                               case_fingerprint(c.image, model, options));
   if (outcome.report["suspect"].get<bool>())
     warn("the result is doubtful: " + outcome.report["reason"].get<std::string>());
   write_outputs(c, in, model, outcome.results, map, outcome.report, progress);

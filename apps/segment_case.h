@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "apps/case_fingerprint.h"
 #include "mesh/progress.h"
 #include "model/label_names.h"
 #include "snake/segment.h"
@@ -22,6 +23,7 @@ struct SegmentModel {
   std::vector<LabelName> labels;  ///< their names and colours
   std::size_t registering = 0;    ///< the structure whose registration every structure shares: the largest
   double load_seconds = 0;
+  std::string fingerprint;  ///< model_fingerprint of its folder
 };
 
 /// \throw InputError as load_model_set does.
@@ -41,8 +43,16 @@ struct SegmentCaseOutcome {
   std::vector<SegmentResult> results;  ///< per structure
 };
 
+/// What a segmentation of `image` with this model and these options records in report.json.
+/// \throw InputError if the image cannot be read.
+CaseFingerprint case_fingerprint(const std::string& image, const SegmentModel& model, const SegmentOptions& options);
+
+/// The report.json of an earlier result in `output` that is complete (every file segment
+/// writes is there) and was made from `expected`; null otherwise.
+nlohmann::json reusable_result(const std::string& output, const SegmentModel& model, const CaseFingerprint& expected);
+
 /// Segments the case into its output folder (replacing only an earlier result of segment):
-/// labels.nii.gz, surfaces/<value>.vtp, report.json, report.html, and for a model of one
+/// labels.nii.gz, surfaces/<value>.vtp, report.json, report.html, slices.png, and for a model of one
 /// structure also surface.vtp and levels/level_j.vtp.
 /// \throw the errors of reading the inputs, of segment() and of the writes; OutputError if the
 ///        output path holds other data.

@@ -139,8 +139,8 @@ nlohmann::json stats_to_json(const DetailStats& s) {
 
 }  // namespace
 
-std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size) {
-  std::uint64_t h = 14695981039346656037ull;
+std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size, std::uint64_t state) {
+  std::uint64_t h = state;
   for (std::size_t i = 0; i < size; ++i) {
     h ^= data[i];
     h *= 1099511628211ull;

@@ -21,8 +21,12 @@ constexpr int kModelFormatVersion = 2;
 /// The format of one structure's folder (save_model, load_model).
 constexpr int kStructureFormatVersion = 1;
 
-/// FNV-1a 64-bit hash of a byte range (the checksum of every model part).
-std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size);
+/// FNV-1a 64's starting state.
+constexpr std::uint64_t kFnv1a64Start = 14695981039346656037ull;
+
+/// FNV-1a 64-bit hash of a byte range (the checksum of every model part). `state` continues
+/// a hash: fnv1a64(b, n, fnv1a64(a, m)) is the hash of a followed by b.
+std::uint64_t fnv1a64(const std::uint8_t* data, std::size_t size, std::uint64_t state = kFnv1a64Start);
 
 /// Writes the model folder atomically: everything goes to a temporary folder beside it,
 /// which is renamed into place at the end. An existing model folder at that path is replaced.

@@ -1,5 +1,6 @@
 #include "apps/report/segment_page.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -76,6 +77,38 @@ TriMesh merged_surfaces(const std::vector<PageStructure>& structures, std::vecto
   return all;
 }
 
+const char* const kAxisNames[] = {"sagittal (x)", "coronal (y)", "axial (z)"};
+
+// What the slices show: every structure's contour in its colour, or the one surface in red
+// with the truth's outline in green.
+struct SliceOverlay {
+  bool several = false;
+  TriMesh all;  ///< with several structures: all their surfaces as one mesh
+  std::vector<double> face_values;
+  const TriMesh* surface = nullptr;
+  std::vector<MeshContour> meshes;
+  std::vector<LabelContour> labels;
+  const TriMesh& centred() const { return several ? all : *surface; }
+};
+
+SliceOverlay slice_overlay(const SegmentPageInput& in) {
+  SliceOverlay o;
+  o.several = in.structures.size() > 1;
+  o.surface = in.surface;
+  if (!o.several) {
+    if (in.truth) o.labels.push_back({in.truth, in.truth_label, {64, 220, 64}, "truth"});
+    o.meshes.push_back({in.surface, {255, 64, 64}, "segmentation"});
+    return o;
+  }
+  o.all = merged_surfaces(in.structures, o.face_values);
+  for (const PageStructure& s : in.structures)
+    o.meshes.push_back({s.surface,
+                        {static_cast<std::uint8_t>(s.color[0]), static_cast<std::uint8_t>(s.color[1]),
+                         static_cast<std::uint8_t>(s.color[2])},
+                        s.name});
+  return o;
+}
+
 // The table of a model of several structures: volume, volume against the model, verdict.
 void structures_table(HtmlPage& page, const nlohmann::json& r) {
   if (!r.is_object() || !r.contains("structures") || r["structures"].size() < 2) return;
@@ -119,19 +152,8 @@ std::string segment_report_html(const SegmentPageInput& in) {
 
   // Slices.
   page.heading("Slices");
-  const bool several = in.structures.size() > 1;
-  std::vector<LabelContour> label_contours;
-  if (in.truth && !several) label_contours.push_back({in.truth, in.truth_label, {64, 220, 64}, "truth"});
-  std::vector<MeshContour> contours{{in.surface, {255, 64, 64}, "segmentation"}};
-  std::vector<double> face_values;
-  const TriMesh all = several ? merged_surfaces(in.structures, face_values) : TriMesh{};
-  if (several) {
-    contours.clear();
-    for (const PageStructure& s : in.structures)
-      contours.push_back({s.surface,
-                          {static_cast<std::uint8_t>(s.color[0]), static_cast<std::uint8_t>(s.color[1]),
-                           static_cast<std::uint8_t>(s.color[2])},
-                          s.name});
+  const SliceOverlay overlay = slice_overlay(in);
+  if (overlay.several) {
     page.paragraph(
         "Three orthogonal slices through the centre of all the structures, each structure's contour in "
         "its colour (the table above).");
@@ -141,22 +163,23 @@ std::string segment_report_html(const SegmentPageInput& in) {
         (in.truth ? ", the truth's outline in green (hidden under the red where the two agree)."
                   : ". (No --truth was given.)"));
   }
-  const TriMesh& centred = several ? all : *in.surface;
   page.begin_figures();
-  const char* axis_names[] = {"sagittal (x)", "coronal (y)", "axial (z)"};
   std::array<double, 3> centre{};
-  picture(page, "The slice centre", [&] { centre = mesh_centre_index(*in.image, centred); });
+  picture(page, "The slice centre", [&] { centre = mesh_centre_index(*in.image, overlay.centred()); });
   for (int axis = 0; axis < 3; ++axis)
-    picture(page, std::string("The ") + axis_names[axis] + " slice", [&] {
-      const Canvas c = slice_with_contours(*in.image, axis, centre[axis], contours, label_contours, 360);
+    picture(page, std::string("The ") + kAxisNames[axis] + " slice", [&] {
+      const Canvas c = slice_with_contours(*in.image, axis, centre[axis], overlay.meshes, overlay.labels, 360);
       char caption[96];
-      std::snprintf(caption, sizeof caption, "%s slice at voxel %.0f", axis_names[axis], std::round(centre[axis]));
+      std::snprintf(caption, sizeof caption, "%s slice at voxel %.0f", kAxisNames[axis], std::round(centre[axis]));
       page.png(c.png(), caption);
     });
   page.end_figures();
 
   // 3D render.
   page.heading("Surface");
+  const bool several = overlay.several;
+  const TriMesh& all = overlay.all;
+  const std::vector<double>& face_values = overlay.face_values;
   std::string why;
   const bool can_render = in.renders && display_available(&why);
   if (!in.renders) why = "3D renders were turned off";
@@ -276,6 +299,27 @@ std::string segment_report_html(const SegmentPageInput& in) {
     page.note("No timings were recorded.");
   }
   return page.str();
+}
+
+std::vector<std::uint8_t> slices_png(const SegmentPageInput& in, int size) {
+  if (!in.image || !in.surface) throw std::invalid_argument("slices_png: the image and the surface are required");
+  const SliceOverlay overlay = slice_overlay(in);
+  const std::array<double, 3> centre = mesh_centre_index(*in.image, overlay.centred());
+  std::vector<Canvas> slices;
+  int width = 0, height = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    slices.push_back(slice_with_contours(*in.image, axis, centre[axis], overlay.meshes, overlay.labels, size));
+    width += slices.back().width();
+    height = std::max(height, slices.back().height());
+  }
+  Canvas strip(width, height);
+  int x0 = 0;
+  for (const Canvas& c : slices) {
+    for (int y = 0; y < c.height(); ++y)
+      for (int x = 0; x < c.width(); ++x) strip.set(x0 + x, y, c.get(x, y));
+    x0 += c.width();
+  }
+  return strip.png();
 }
 
 void write_segment_report(const std::string& path, const SegmentPageInput& input) {

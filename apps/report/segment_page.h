@@ -7,6 +7,7 @@
 /// The page takes plain data (no snake types), so the report library stays below the
 /// segmentation in the layers; cmd_segment fills it from SegmentResult and segment_report.
 #include <array>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -59,6 +60,12 @@ struct SegmentPageInput {
 /// \pre input.image and input.surface are set.
 /// \throw std::invalid_argument if they are not.
 std::string segment_report_html(const SegmentPageInput& input);
+
+/// PNG bytes of the page's three orthogonal slices side by side, each at most `size` pixels:
+/// a thumbnail of the result for study pages and file browsers.
+/// \pre input.image and input.surface are set; size > 0.
+/// \throw std::invalid_argument if they are not set; Error if the slices cannot be drawn.
+std::vector<std::uint8_t> slices_png(const SegmentPageInput& input, int size = 200);
 
 /// Writes segment_report_html atomically to `path`.
 /// \throw OutputError if the file cannot be written.

@@ -362,6 +362,63 @@ TEST_F(Robustness, BatchGoesOnPastABadImageAndSummarizesEveryImage) {
   EXPECT_EQ(run_mrsnake("segment-batch --model " + path("ellipsoid.model") + " -o " + path("batch-none")).exit_code, 2);
 }
 
+TEST_F(Robustness, BatchResumeKeepsOnlyCompleteResultsOfTheSameInputs) {
+  // Two images, one of them a MetaImage whose voxels sit in a file of their own.
+  const fs::path in = *dir_ / "resume-in";
+  fs::create_directories(in);
+  fs::copy_file(path("tgt/image.nii.gz"), in / "a.nii.gz");
+  {
+    const mrsnake::Volume ref = mrsnake::read_volume(path("ref/image.nii.gz"));
+    std::ofstream(in / "b.mhd") << "ObjectType = Image\nNDims = 3\nDimSize = " << ref.size[0] << " " << ref.size[1]
+                                << " " << ref.size[2] << "\nElementSpacing = " << ref.spacing[0] << " "
+                                << ref.spacing[1] << " " << ref.spacing[2]
+                                << "\nElementType = MET_FLOAT\nElementByteOrderMSB = False\nElementDataFile = b.raw\n";
+    std::ofstream(in / "b.raw", std::ios::binary)
+        .write(reinterpret_cast<const char*>(ref.data.data()), static_cast<std::streamsize>(ref.data.size() * 4));
+  }
+  const std::string out = path("resume-out");
+  const std::string batch = "-q segment-batch --model " + path("ellipsoid.model") + " -o " + out + " " +
+                            (in / "a.nii.gz").string() + " " + (in / "b.mhd").string();
+  const auto run = [&](const std::string& extra) {
+    const auto r = run_mrsnake(batch + extra);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    const auto summary = nlohmann::json::parse(mrsnake::test::read_all(fs::path(out) / "batch.json"));
+    std::vector<bool> resumed;
+    for (const auto& c : summary["cases"]) resumed.push_back(c["resumed"].get<bool>());
+    return resumed;
+  };
+  EXPECT_EQ(run(""), (std::vector<bool>{false, false}));
+  const auto report_a = nlohmann::json::parse(mrsnake::test::read_all(fs::path(out) / "a" / "report.json"));
+  for (const char* key : {"image_fnv1a64", "model_fnv1a64", "options_fnv1a64"})
+    EXPECT_EQ(report_a["fingerprint"][key].get<std::string>().size(), 16u) << key;
+  EXPECT_TRUE(fs::is_regular_file(fs::path(out) / "a" / "slices.png"));
+
+  // Nothing changed: both kept, their files untouched.
+  const auto written = fs::last_write_time(fs::path(out) / "a" / "labels.nii.gz");
+  EXPECT_EQ(run(" --resume"), (std::vector<bool>{true, true}));
+  EXPECT_EQ(fs::last_write_time(fs::path(out) / "a" / "labels.nii.gz"), written);
+  // Without --resume every image is segmented again.
+  EXPECT_EQ(run(""), (std::vector<bool>{false, false}));
+
+  // The MetaImage's voxels change (its header does not): only b is redone.
+  {
+    std::fstream raw(in / "b.raw", std::ios::in | std::ios::out | std::ios::binary);
+    ASSERT_TRUE(raw.good());
+    const float v = 123.f;
+    raw.seekp(4 * 100);
+    raw.write(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  EXPECT_EQ(run(" --resume"), (std::vector<bool>{true, false}));
+  // An incomplete result is redone; other options redo every image.
+  fs::remove(fs::path(out) / "a" / "slices.png");
+  EXPECT_EQ(run(" --resume"), (std::vector<bool>{false, true}));
+  EXPECT_EQ(run(" --resume --max-iterations 7"), (std::vector<bool>{false, false}));
+  std::ifstream csv(fs::path(out) / "batch.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_NE(header.find(",error,resumed"), std::string::npos) << header;
+}
+
 TEST_F(Robustness, BatchNamesAreDistinctAndNeverReplaceOtherData) {
   // Copies of one image under names that collide, that are the summary's own, that are
   // hidden, that are not UTF-8 (byte 0xFF), and one named like a folder of other data in -o.
