@@ -1,0 +1,102 @@
+#!/usr/bin/env bash
+# The study workflow (workflow/Snakefile through scripts/study), run locally for real on 6
+# synthetic volumes in two groups, one of pure noise and one corrupt file:
+#   1. the table against every volume's report.json, the failed volume listed, the noise image
+#      flagged with its thumbnail in the page;
+#   2. a second run does nothing;
+#   3. a new reference (so a new model) reruns every segmentation; that run is killed mid-way
+#      and resumed, and the volumes finished before the kill are not segmented again;
+#   4. two rows added to the manifest run two segmentations and nothing else.
+# Exit 77 (ctest: skipped) when Snakemake is not installed.
+set -euo pipefail
+: "${MRSNAKE_BIN:?MRSNAKE_BIN is not set; run through ctest}"
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+python=/usr/bin/python3
+if ! command -v snakemake >/dev/null || ! "$python" -c "import pandas, seaborn, yaml" 2>/dev/null; then
+  echo "SKIP: Snakemake, pandas, seaborn or PyYAML is missing (scripts/setup installs them)"
+  exit 77
+fi
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+export MRSNAKE_BIN
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+# The reference and the volumes: group A and group B, whose blobs are deformed more.
+"$MRSNAKE_BIN" -q synth --shape ellipsoid --size 48 --snr 6 --seed 5 -o "$work/reference"
+echo "id,image,group" >"$work/manifest.csv"
+for i in 1 2 3; do
+  "$MRSNAKE_BIN" -q synth --shape ellipsoid --size 48 --snr 6 --pose random --seed $((20 + i)) -o "$work/a$i"
+  "$MRSNAKE_BIN" -q synth --shape ellipsoid --size 48 --snr 6 --pose random --deform 2 --seed $((30 + i)) -o "$work/b$i"
+  echo "a$i,a$i/image.nii.gz,A" >>"$work/manifest.csv"
+  echo "b$i,b$i/image.nii.gz,B" >>"$work/manifest.csv"
+done
+echo "not an image" >"$work/bad.nii.gz"
+echo "bad,bad.nii.gz,B" >>"$work/manifest.csv"
+# Pure noise: segmented, and flagged as matching the image hardly better than chance.
+"$MRSNAKE_BIN" -q synth --shape ellipsoid --size 48 --contrast 100,99 --snr 0.05 --seed 7 -o "$work/noise"
+echo "noise,noise/image.nii.gz,A" >>"$work/manifest.csv"
+cat >"$work/study.yaml" <<YAML
+reference: {labels: reference/truth.nii.gz, image: reference/image.nii.gz, structures: [1]}
+manifest: manifest.csv
+output: out
+YAML
+out="$work/out"
+study() {
+  local code=0
+  "$root/scripts/study" "$work/study.yaml" "$@" >"$work/run.log" 2>&1 || code=$?
+  echo "$code"
+}
+newer_than() { find "$out/status" -name '*.json' -newer "$1" | sort | xargs -r -n1 basename | tr '\n' ' '; }
+
+echo "== 1. the first run"
+code=$(study)
+[ "$code" = 6 ] || { cat "$work/run.log"; fail "the first run exited $code, expected 6 (one volume failed)"; }
+"$python" "$root/tests/workflow/check_study_table.py" "$out" a1,b1,a2,b2,a3,b3,bad,noise bad
+grep -q 'alt="slices of noise"' "$out/study/report.html" || fail "the page does not show the doubtful noise image"
+grep -q '^noise,.*,ok,True,' "$out/study/volumes.csv" || fail "volumes.csv does not flag the noise image"
+
+echo "== 2. a second run does nothing"
+touch "$work/mark2"
+sleep 1
+code=$(study)
+[ "$code" = 6 ] || fail "the second run exited $code"
+grep -q "Nothing to be done" "$work/run.log" || { cat "$work/run.log"; fail "the second run ran jobs"; }
+[ -z "$(newer_than "$work/mark2")" ] || fail "the second run rewrote $(newer_than "$work/mark2")"
+
+echo "== 3. a new reference reruns every segmentation; killed mid-way, then resumed"
+touch "$work/mark3"
+sleep 1
+# Another reference, not merely a touched one: Snakemake compares the content of small inputs.
+"$MRSNAKE_BIN" -q synth --shape ellipsoid --size 48 --snr 6 --seed 6 -o "$work/reference"
+setsid "$root/scripts/study" "$work/study.yaml" >"$work/killed.log" 2>&1 &
+run=$!
+for _ in $(seq 1 1200); do  # at most 120 s for the model and a first segmentation (not the corrupt file's)
+  newer_than "$work/mark3" | grep -q '[ab][0-9]' && break
+  sleep 0.1
+done
+kill -TERM -- "-$run" 2>/dev/null || true
+wait "$run" || true
+before=$(newer_than "$work/mark3")
+count=$(echo "$before" | wc -w)
+[ "$count" -ge 1 ] && [ "$count" -lt 8 ] || { cat "$work/killed.log"; fail "the kill came after $count of 8 volumes"; }
+echo "killed after: $before"
+declare -A stamp
+for id in $before; do stamp[$id]=$(stat -c %Y.%y "$out/status/$id"); done
+code=$(study)
+[ "$code" = 6 ] || { cat "$work/run.log"; fail "the resumed run exited $code"; }
+for id in $before; do
+  [ "$(stat -c %Y.%y "$out/status/$id")" = "${stamp[$id]}" ] || fail "$id, done before the kill, was done again"
+done
+[ "$(newer_than "$work/mark3" | wc -w)" = 8 ] || fail "not every volume was redone with the new model"
+
+echo "== 4. two rows added run two segmentations"
+touch "$work/mark4"
+sleep 1
+"$MRSNAKE_BIN" -q synth --shape ellipsoid --size 48 --snr 6 --pose random --seed 41 -o "$work/c1"
+"$MRSNAKE_BIN" -q synth --shape ellipsoid --size 48 --snr 6 --pose random --seed 42 -o "$work/c2"
+printf 'c1,c1/image.nii.gz,A\nc2,c2/image.nii.gz,B\n' >>"$work/manifest.csv"
+code=$(study)
+[ "$code" = 6 ] || { cat "$work/run.log"; fail "the run with two more rows exited $code"; }
+[ "$(newer_than "$work/mark4")" = "c1.json c2.json " ] || fail "the new rows ran $(newer_than "$work/mark4")"
+"$python" "$root/tests/workflow/check_study_table.py" "$out" a1,b1,a2,b2,a3,b3,bad,noise,c1,c2 bad
+echo "PASS: the local study workflow"
