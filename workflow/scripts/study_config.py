@@ -48,9 +48,10 @@ class Study:
     segment_options: Optional[str] = None
     build_options: Optional[str] = None
     ids: List[str] = field(default_factory=list)
+    by_id: Dict[str, Case] = field(default_factory=dict)
 
     def case(self, case_id: str) -> Case:
-        return self.cases[self.ids.index(case_id)]
+        return self.by_id[case_id]
 
 
 def _path(base: Path, value, key: str) -> str:
@@ -136,7 +137,7 @@ def load_study(config: dict, config_dir: Path) -> Study:
     manifest = _path(config_dir, config["manifest"], "manifest")
     cases, extra = read_manifest(manifest)
     study = Study(output=_path(config_dir, config["output"], "output"), manifest=manifest, cases=cases,
-                  extra_columns=extra, ids=[c.id for c in cases])
+                  extra_columns=extra, ids=[c.id for c in cases], by_id={c.id: c for c in cases})
     if "reference" in config:
         study.reference = _reference(config_dir, config["reference"])
     else:
