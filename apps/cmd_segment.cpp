@@ -102,7 +102,9 @@ void print_case_summary(const SegmentCase& c, const SegmentModel& model, const S
     }
     info(text);
   }
-  info("wrote " + c.output + "/{labels.nii.gz, surfaces/, report.json, report.html, slices.png" +
+  info("wrote " + c.output +
+       "/{labels.nii.gz, labels.seg.nrrd, labels.ctbl, labels.itksnap.txt, surfaces/, report.json, report.html, "
+       "slices.png" +
        (model.structures.size() == 1 ? std::string(", surface.vtp, levels/}") : std::string("}")));
 }
 
@@ -123,8 +125,9 @@ void add_segment_command(CLI::App& app) {
   cmd->add_option("--image", a->c.image, "Volume to segment (.nii.gz .nrrd .mha ..., or a DICOM folder)")->required();
   cmd->add_option("--model", a->model, "Shape model folder (made by 'mrsnake build-model')")->required();
   cmd->add_option("-o,--output", a->c.output,
-                  "Output folder: labels.nii.gz (the reference's label values), surfaces/VALUE.vtp, report.json, "
-                  "report.html, slices.png; for a model of one structure also surface.vtp and levels/level_j.vtp")
+                  "Output folder: labels.nii.gz (the reference's label values; named in labels.seg.nrrd, labels.ctbl "
+                  "and labels.itksnap.txt), surfaces/VALUE.vtp, report.json, report.html, slices.png; for a model of "
+                  "one structure also surface.vtp and levels/level_j.vtp")
       ->required();
   a->snake.add_to(cmd);
   cmd->add_option("--truth", a->c.truth,

@@ -16,6 +16,7 @@
 #include "mesh/marching_cubes.h"
 #include "mesh/mesh_io.h"
 #include "mesh/parallel.h"
+#include "model/label_files.h"
 #include "model/model_set.h"
 #include "model/snake_adapter.h"
 #include "snake/label_map.h"
@@ -36,7 +37,8 @@ bool one_structure(const SegmentModel& model) { return model.structures.size() =
 ReplaceableFolder segment_folder() {
   return folder_of_entries(
       [](const std::string& name) {
-        return name == "surface.vtp" || name == "labels.nii.gz" || name == "levels" || name == "surfaces" ||
+        return name == "surface.vtp" || name == "labels.nii.gz" || name == "labels.seg.nrrd" ||
+               name == "labels.itksnap.txt" || name == "labels.ctbl" || name == "levels" || name == "surfaces" ||
                name == "report.json" || name == "report.html" || name == "slices.png";
       },
       "an output of mrsnake segment");
@@ -258,6 +260,18 @@ VoxelType label_voxel_type(const SegmentModel& model) {
   return *std::max_element(model.values.begin(), model.values.end()) > 255 ? VoxelType::int16 : VoxelType::uint8;
 }
 
+// The label map with its names and colours: labels.nii.gz, and for 3D Slicer and ITK-SNAP a
+// segmentation of named segments (labels.seg.nrrd), a colour table and a label description.
+void write_label_files(const fs::path& dir, const SegmentModel& model, const Volume& labels) {
+  std::vector<NamedValue> named;
+  for (std::size_t i = 0; i < model.values.size(); ++i) named.push_back({model.values[i], model.labels[i]});
+  const VoxelType type = label_voxel_type(model);
+  write_volume((dir / "labels.nii.gz").string(), labels, type);
+  write_volume((dir / "labels.seg.nrrd").string(), labels, type, slicer_segmentation_fields(named, labels));
+  write_text_file_atomically((dir / "labels.itksnap.txt").string(), itksnap_label_description(named));
+  write_text_file_atomically((dir / "labels.ctbl").string(), slicer_color_table(named));
+}
+
 // Everything goes to a temporary folder renamed into place at the end.
 void write_outputs(const SegmentCase& c, const CaseInputs& in, const SegmentModel& model,
                    const std::vector<SegmentResult>& results, const StructureLabelMap& map, const nlohmann::json& rep,
@@ -267,7 +281,7 @@ void write_outputs(const SegmentCase& c, const CaseInputs& in, const SegmentMode
   const fs::path dir = out.temp_path();
   // The compressed labels are written on the other core, beside the meshes.
   run_both_in_parallel([&] { write_meshes(dir, model, results, rep); },
-                       [&] { write_volume((dir / "labels.nii.gz").string(), map.labels, label_voxel_type(model)); });
+                       [&] { write_label_files(dir, model, map.labels); });
   // After the join: the page's render forks a child, which must not start while another
   // thread may hold a lock (the allocator's, the loader's) that the child would then wait on.
   write_pages(dir, c, in, model, results, rep);
@@ -304,7 +318,8 @@ CaseFingerprint case_fingerprint(const std::string& image, const SegmentModel& m
 
 nlohmann::json reusable_result(const std::string& output, const SegmentModel& model, const CaseFingerprint& expected) {
   const fs::path dir(output);
-  std::vector<fs::path> files{"labels.nii.gz", "report.json", "report.html", "slices.png"};
+  std::vector<fs::path> files{"labels.nii.gz", "labels.seg.nrrd", "labels.itksnap.txt", "labels.ctbl",
+                              "report.json",   "report.html",     "slices.png"};
   for (const int value : model.values) files.push_back(fs::path("surfaces") / (std::to_string(value) + ".vtp"));
   if (one_structure(model)) files.push_back("surface.vtp");
   std::error_code ec;

@@ -10,6 +10,7 @@
 #include <itkImageFileWriter.h>
 #include <itkImageIOFactory.h>
 #include <itkImageSeriesReader.h>
+#include <itkMetaDataObject.h>
 #include <itkMetaImageIOFactory.h>
 #include <itkNiftiImageIOFactory.h>
 #include <itkNrrdImageIOFactory.h>
@@ -266,6 +267,11 @@ Volume read_volume(const std::string& path) {
 }
 
 void write_volume(const std::string& path, const Volume& volume, VoxelType type) {
+  write_volume(path, volume, type, {});
+}
+
+void write_volume(const std::string& path, const Volume& volume, VoxelType type,
+                  const std::vector<std::pair<std::string, std::string>>& fields) {
   register_image_io();
   if (volume.data.size() != volume.num_voxels()) throw OutputError("internal: volume buffer does not match its size");
   auto image = FloatImage::New();
@@ -298,6 +304,8 @@ void write_volume(const std::string& path, const Volume& volume, VoxelType type)
       const float* src = image->GetBufferPointer();
       Pixel* dst = cast->GetBufferPointer();
       for (std::size_t i = 0; i < volume.num_voxels(); ++i) dst[i] = static_cast<Pixel>(src[i]);
+      for (const auto& [key, value] : fields)
+        itk::EncapsulateMetaData<std::string>(cast->GetMetaDataDictionary(), key, value);
       auto writer = itk::ImageFileWriter<OutImage>::New();
       writer->SetFileName(out.temp_path());
       writer->SetInput(cast);

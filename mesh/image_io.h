@@ -3,6 +3,8 @@
 /// Reading and writing 3D images through ITK. The only interface is the plain `Volume`;
 /// the ITK code lives in image_io.cpp, a translation unit that sees no Eigen or CGAL.
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "mesh/volume.h"
 
@@ -22,5 +24,12 @@ Volume read_volume(const std::string& path);
 /// \pre volume.data.size() == volume.num_voxels()
 /// \throw OutputError if it cannot be written.
 void write_volume(const std::string& path, const Volume& volume, VoxelType type);
+
+/// Writes a volume as write_volume does, with `fields` as key/value pairs of its header (NRRD
+/// writes each as a `key:=value` line; formats without such pairs drop them).
+/// \pre volume.data.size() == volume.num_voxels(); no key or value holds a line break.
+/// \throw OutputError if it cannot be written.
+void write_volume(const std::string& path, const Volume& volume, VoxelType type,
+                  const std::vector<std::pair<std::string, std::string>>& fields);
 
 }  // namespace mrsnake
