@@ -54,7 +54,7 @@ std::string poor_fit_cause(const StructureScale& scale, const SurfaceChoices& c)
 
 // The command's arguments: the options file, and the flags that override it.
 struct BuildModelArgs {
-  std::string labels, image, output, config, label = "1", label_names;
+  std::string labels, image, output, config, label = "1", label_names, labels_series, image_series;
   std::optional<int> faces, component, close_tunnels;
   bool allow_poor_fit = false, json = false;
 };
@@ -283,8 +283,9 @@ void run_build_model(const BuildModelArgs& a) {
   const std::map<int, LabelName> names =
       a.label_names.empty() ? std::map<int, LabelName>{} : read_label_names(a.label_names);
   report(progress, "reading " + a.labels, 0.0);
-  const Volume labels = read_volume(a.labels);
-  const std::optional<Volume> image = a.image.empty() ? std::nullopt : std::optional<Volume>(read_volume(a.image));
+  const Volume labels = read_volume(a.labels, a.labels_series);
+  const std::optional<Volume> image =
+      a.image.empty() ? std::nullopt : std::optional<Volume>(read_volume(a.image, a.image_series));
   const double read_seconds = seconds_since(t_start);
 
   BuiltModelSet set = build_with_hints(labels, image ? &*image : nullptr, selection, names, options, progress);
@@ -339,6 +340,10 @@ void add_build_model_command(CLI::App& app) {
                   "Reference intensity image of the labels (same physical space): stores the appearance "
                   "(profiles along the normals, inside/outside statistics) that 'mrsnake segment' matches, and a "
                   "crop of the image around the organ that 'mrsnake segment --init register' registers to a new image");
+  cmd->add_option("--labels-series", a->labels_series,
+                  "The DICOM series of the --labels folder when it holds several: its Series Instance UID");
+  cmd->add_option("--image-series", a->image_series,
+                  "The DICOM series of the --image folder when it holds several: its Series Instance UID");
   cmd->add_option("-o,--output", a->output, "Output model folder (replaced if it is already a model)")->required();
   cmd->add_option("--faces", a->faces,
                   "Wanted face count of the finest level (default: triangles with edges of half the surface's "

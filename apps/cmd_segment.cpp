@@ -123,6 +123,9 @@ void add_segment_command(CLI::App& app) {
   };
   auto a = std::make_shared<Args>();
   cmd->add_option("--image", a->c.image, "Volume to segment (.nii.gz .nrrd .mha ..., or a DICOM folder)")->required();
+  cmd->add_option("--series", a->c.series,
+                  "The DICOM series to segment when the --image folder holds several: its Series Instance UID "
+                  "(without it, such a folder is refused with a list of its series)");
   cmd->add_option("--model", a->model, "Shape model folder (made by 'mrsnake build-model')")->required();
   cmd->add_option("-o,--output", a->c.output,
                   "Output folder: labels.nii.gz (the reference's label values; named in labels.seg.nrrd, labels.ctbl "

@@ -56,7 +56,7 @@ struct CaseInputs {
 CaseInputs read_inputs(const SegmentCase& c) {
   const auto t = std::chrono::steady_clock::now();
   CaseInputs in;
-  in.image = read_volume(c.image);
+  in.image = read_volume(c.image, c.series);
   if (!c.truth.empty()) {
     in.truth = read_volume(c.truth);
     require_same_grid(in.image, in.truth, "IMAGE", "TRUTH");

@@ -32,6 +32,7 @@ SegmentModel load_segment_model(const std::string& path);
 /// One image to segment, and where.
 struct SegmentCase {
   std::string image, truth, output;
+  std::string series;  ///< the DICOM series of a folder `image` that holds several (read_volume)
   /// The structure's value in the truth, for a model of one structure; < 0: its own value,
   /// or 1 (as synth writes a truth) when the truth does not hold it. A model of several is
   /// scored on each structure's own value.
