@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "apps/cli.h"
+#include "apps/slicer_module.h"
 #include "apps/report/remesh_page.h"
 #include "mesh/atomic_file.h"
 #include "mesh/errors.h"
@@ -326,8 +327,7 @@ void add_build_model_command(CLI::App& app) {
                          "Build a multiresolution shape model of one or more labels of a label image: marching cubes, "
                          "semi-regular remeshing, lifting-wavelet analysis");
   auto a = std::make_shared<BuildModelArgs>();
-  cmd->add_option("--labels", a->labels, "Label volume (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)")
-      ->required();
+  cmd->add_option("--labels", a->labels, "Label volume (.nii .nii.gz .nrrd .mha .mhd .gipl, or a DICOM folder)");
   cmd->add_option("--label", a->label,
                   "Label values of the structures, e.g. 5 or 1,3,7,8, or all: every label whose surface is closed "
                   "genus 0 (after --close-tunnels), the others skipped with their reason; one model folder holds them")
@@ -383,7 +383,26 @@ void add_build_model_command(CLI::App& app) {
       "with tunnels of up to 3 voxels (genus > 0) is closed by default, e.g. the liver of abdomen-ct-small-seg.nii.gz\n"
       "(label 5); wider ones need a larger --close-tunnels.\n"
       "Build again exactly: mrsnake build-model ... --config <(jq .build_options MODEL/model.json)");
-  cmd->callback([a] { run_build_model(*a); });
+  // As a 3D Slicer CLI module (docs/slicer.md): the reference labels and image positionally.
+  auto positional = std::make_shared<std::pair<std::string, std::string>>();
+  cmd->add_option("LABELS", positional->first, "The label volume, as a positional argument (instead of --labels)");
+  cmd->add_option("IMAGE", positional->second, "The reference image, as a positional argument (instead of --image)");
+  cmd->add_flag_callback(
+      "--xml",
+      [] {
+        std::cout << build_model_module_xml();
+        throw CLI::Success();
+      },
+      "Print the 3D Slicer CLI module description (Slicer Execution Model XML) and exit");
+  cmd->callback([a, positional] {
+    if (a->labels.empty() == positional->first.empty())
+      throw CLI::ValidationError("--labels", "give the label volume once: --labels LABELS, or LABELS first");
+    if (!positional->second.empty() && !a->image.empty())
+      throw CLI::ValidationError("--image", "give the reference image once: --image IMAGE, or IMAGE second");
+    if (a->labels.empty()) a->labels = positional->first;
+    if (a->image.empty()) a->image = positional->second;
+    run_build_model(*a);
+  });
 }
 
 }  // namespace mrsnake::cli

@@ -8,15 +8,19 @@
 #include <functional>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <set>
 #include <thread>
 #include <vector>
+
+#include <unistd.h>
 
 #include "apps/batch_pool.h"
 #include "apps/cli.h"
 #include "apps/exit_codes.h"
 #include "apps/hints.h"
 #include "apps/report/segment_page.h"
+#include "apps/slicer_module.h"
 #include "mesh/atomic_file.h"
 #include "mesh/distance.h"
 #include "mesh/errors.h"
@@ -108,6 +112,94 @@ void print_case_summary(const SegmentCase& c, const SegmentModel& model, const S
        (model.structures.size() == 1 ? std::string(", surface.vtp, levels/}") : std::string("}")));
 }
 
+// segment as a 3D Slicer CLI module: the image and the outputs Slicer loads back as positional
+// arguments (the schema's indexed parameters), the result folder optional, and Slicer's
+// return parameter file.
+struct SlicerOutputs {
+  std::string image, labels, surfaces, return_parameters;
+};
+
+void add_slicer_form(CLI::App* cmd, SlicerOutputs& s) {
+  cmd->add_option("IMAGE", s.image, "The volume to segment, as a positional argument (instead of --image)");
+  cmd->add_option("LABELS_OUT", s.labels,
+                  "Also write the label map here (any image format: .nrrd, .nii.gz, ...), as 3D Slicer asks");
+  cmd->add_option("SURFACES_OUT", s.surfaces,
+                  "Also write every structure's surface here, as one mesh (.vtk .vtp .stl .ply .obj)");
+  cmd->add_option("--returnparameterfile", s.return_parameters,
+                  "Write volume_mm3, suspect and reason here as 'name = value' lines (3D Slicer's return parameters)");
+  cmd->add_flag_callback(
+      "--xml",
+      [] {
+        std::cout << segment_module_xml();
+        throw CLI::Success();
+      },
+      "Print the 3D Slicer CLI module description (Slicer Execution Model XML) and exit");
+}
+
+// The result folder of a run without -o: a temporary one, removed when the run ends.
+class TemporaryResult {
+ public:
+  explicit TemporaryResult(std::string path) : path_(std::move(path)) {}
+  ~TemporaryResult() {
+    std::error_code ec;
+    if (!path_.empty()) std::filesystem::remove_all(path_, ec);
+  }
+  TemporaryResult(const TemporaryResult&) = delete;
+  TemporaryResult& operator=(const TemporaryResult&) = delete;
+
+ private:
+  std::string path_;
+};
+
+// The image and the result folder of the run, from the flags or the positional form.
+std::unique_ptr<TemporaryResult> start_slicer_form(const SlicerOutputs& s, std::string& image, std::string& output) {
+  if (image.empty() == s.image.empty())
+    throw CLI::ValidationError("--image", "give the volume to segment once: --image IMAGE, or IMAGE first");
+  if (image.empty()) image = s.image;
+  if (!output.empty()) return nullptr;
+  if (s.labels.empty()) throw CLI::ValidationError("-o", "give the result folder, -o DIR (or LABELS_OUT after IMAGE)");
+  output = (std::filesystem::temp_directory_path() / ("mrsnake-segment-" + std::to_string(::getpid()))).string();
+  return std::make_unique<TemporaryResult>(output);
+}
+
+// Every structure's surface as one mesh.
+TriMesh all_surfaces(const std::vector<SegmentResult>& results) {
+  TriMesh all;
+  Eigen::Index nv = 0, nf = 0;
+  for (const SegmentResult& r : results) {
+    nv += r.surface.num_vertices();
+    nf += r.surface.num_faces();
+  }
+  all.V.resize(nv, 3);
+  all.F.resize(nf, 3);
+  nv = nf = 0;
+  for (const SegmentResult& r : results) {
+    all.V.middleRows(nv, r.surface.num_vertices()) = r.surface.V;
+    all.F.middleRows(nf, r.surface.num_faces()) = r.surface.F.array() + static_cast<int>(nv);
+    nv += r.surface.num_vertices();
+    nf += r.surface.num_faces();
+  }
+  return all;
+}
+
+// The positional outputs and the return parameters, from the result folder and the run.
+void finish_slicer_form(const SlicerOutputs& s, const std::string& output, const SegmentModel& model,
+                        const SegmentCaseOutcome& outcome) {
+  if (!s.labels.empty()) {
+    const int largest = *std::max_element(model.values.begin(), model.values.end());
+    write_volume(s.labels, read_volume(output + "/labels.nii.gz"), largest > 255 ? VoxelType::int16 : VoxelType::uint8);
+  }
+  if (!s.surfaces.empty()) write_mesh(s.surfaces, all_surfaces(outcome.results));
+  for (const std::string& path : {s.labels, s.surfaces, s.return_parameters})
+    if (!path.empty()) info("wrote " + path);
+  if (!s.return_parameters.empty()) {
+    double volume = 0;
+    for (const nlohmann::json& st : outcome.report["structures"]) volume += st["volume_mm3"].get<double>();
+    write_return_parameters(s.return_parameters, {{"volume_mm3", std::to_string(volume)},
+                                                  {"suspect", outcome.report["suspect"].get<bool>() ? "true" : "false"},
+                                                  {"reason", outcome.report["reason"].get<std::string>()}});
+  }
+}
 }  // namespace
 
 void add_segment_command(CLI::App& app) {
@@ -120,9 +212,10 @@ void add_segment_command(CLI::App& app) {
     bool json = false;
     int truth_label = 1;
     const CLI::Option* truth_label_flag = nullptr;
+    SlicerOutputs slicer;
   };
   auto a = std::make_shared<Args>();
-  cmd->add_option("--image", a->c.image, "Volume to segment (.nii.gz .nrrd .mha ..., or a DICOM folder)")->required();
+  cmd->add_option("--image", a->c.image, "Volume to segment (.nii.gz .nrrd .mha ..., or a DICOM folder)");
   cmd->add_option("--series", a->c.series,
                   "The DICOM series to segment when the --image folder holds several: its Series Instance UID "
                   "(without it, such a folder is refused with a list of its series)");
@@ -130,8 +223,7 @@ void add_segment_command(CLI::App& app) {
   cmd->add_option("-o,--output", a->c.output,
                   "Output folder: labels.nii.gz (the reference's label values; named in labels.seg.nrrd, labels.ctbl "
                   "and labels.itksnap.txt), surfaces/VALUE.vtp, report.json, report.html, slices.png; for a model of "
-                  "one structure also surface.vtp and levels/level_j.vtp")
-      ->required();
+                  "one structure also surface.vtp and levels/level_j.vtp");
   a->snake.add_to(cmd);
   cmd->add_option("--truth", a->c.truth,
                   "Truth labels on the image's grid: adds the scores of 'mrsnake evaluate' to the report");
@@ -141,6 +233,7 @@ void add_segment_command(CLI::App& app) {
                       "when the truth holds it, else 1); a model of several is scored on each "
                       "structure's own value");
   cmd->add_flag("--json", a->json, "Print the report as JSON on stdout");
+  add_slicer_form(cmd, a->slicer);
   cmd->footer(
       "Example:\n"
       "  mrsnake segment --image case7/image.nii.gz --model heart.model -o case7/seg --truth case7/truth.nii.gz\n"
@@ -151,9 +244,11 @@ void add_segment_command(CLI::App& app) {
       "With a model built by 'build-model --image', the default initialization registers the model's\n"
       "reference image to IMAGE (ITK, similarity), then fits the coarse mesh; report.json's\n"
       "'registration' holds the transform, the metric and whether it was used or why not.\n"
-      "Many images with one model: 'mrsnake segment-batch'.");
+      "Many images with one model: 'mrsnake segment-batch'. As a 3D Slicer module (--xml, docs/slicer.md):\n"
+      "  mrsnake segment --model heart.model [-o DIR] IMAGE LABELS_OUT [SURFACES_OUT]");
   cmd->callback([a] {
     const auto progress = terminal_progress();
+    const auto temporary = start_slicer_form(a->slicer, a->c.image, a->c.output);
     const SegmentOptions options = a->snake.options();
     report(progress, "load", 0.0);
     if (a->truth_label_flag->count() > 0) a->c.truth_label = a->truth_label;
@@ -164,6 +259,7 @@ void add_segment_command(CLI::App& app) {
           "truth of a model of several must hold the reference's values");
     const SegmentCaseOutcome outcome = segment_case(a->c, model, a->model, options, model.load_seconds, progress);
     const nlohmann::json& rep = outcome.report;
+    finish_slicer_form(a->slicer, a->c.output, model, outcome);
     if (a->json) {
       print_json(rep);
     } else {

@@ -7,7 +7,6 @@ offset), so that a mix-up of LPS and RAS, of axes or of the origin shows.
   independent_readers.py   (MRSNAKE_BIN names the mrsnake executable)
 Exit 77 when nibabel or VTK's Python module is missing.
 """
-import gzip
 import json
 import os
 import subprocess
@@ -18,6 +17,7 @@ try:
     import nibabel as nib
     import numpy as np
     from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+    from nrrd_reader import nrrd_affine_ras, read_nrrd
 except ImportError as e:
     print(f"SKIP: {e.name} is missing (scripts/setup installs python3-nibabel and python3-vtk9)")
     sys.exit(77)
@@ -35,41 +35,6 @@ def oblique(path_in, path_out, affine):
     """The same voxels on another grid: rotated 30° about z, anisotropic, offset."""
     img = nib.load(path_in)
     nib.save(nib.Nifti1Image(np.asanyarray(img.dataobj), affine), path_out)
-
-
-def read_nrrd(path):
-    """(fields, key/values, voxels) of an attached-header gzip NRRD, by the format's spec."""
-    with open(path, "rb") as f:
-        data = f.read()
-    header, payload = data.split(b"\n\n", 1)
-    lines = header.decode("ascii").split("\n")
-    assert lines[0].startswith("NRRD000"), lines[0]
-    fields, pairs = {}, {}
-    for line in lines[1:]:
-        if line.startswith("#") or not line:
-            continue
-        if ":=" in line:
-            key, value = line.split(":=", 1)
-            pairs[key] = value
-        else:
-            key, value = line.split(": ", 1)
-            fields[key] = value
-    assert fields["encoding"] == "gzip", fields["encoding"]
-    dtype = {"unsigned char": np.uint8, "uchar": np.uint8, "short": np.int16}[fields["type"]]
-    sizes = [int(s) for s in fields["sizes"].split()]
-    voxels = np.frombuffer(gzip.decompress(payload), dtype=dtype).reshape(sizes, order="F")
-    return fields, pairs, voxels
-
-
-def nrrd_affine_ras(fields):
-    """The NRRD's index-to-RAS matrix from its LPS space directions and origin."""
-    assert fields["space"] == "left-posterior-superior", fields["space"]
-    vectors = [[float(x) for x in v.strip("()").split(",")] for v in fields["space directions"].split()]
-    origin = [float(x) for x in fields["space origin"].strip("()").split(",")]
-    lps = np.eye(4)
-    lps[:3, :3] = np.array(vectors).T
-    lps[:3, 3] = origin
-    return np.diag([-1.0, -1.0, 1.0, 1.0]) @ lps
 
 
 def check_labels(out, affine, report):
