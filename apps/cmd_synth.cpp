@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "apps/cli.h"
+#include "model/label_files.h"
 #include "mesh/atomic_file.h"
 #include "mesh/errors.h"
 #include "mesh/image_io.h"
@@ -66,7 +67,9 @@ void add_synth_command(CLI::App& app) {
     bool json = false;
   };
   auto a = std::make_shared<Args>();
-  cmd->add_option("-o,--output", a->out, "Output folder: image.nii.gz, truth.nii.gz, truth.vtp, params.json")
+  cmd->add_option("-o,--output", a->out,
+                  "Output folder: image.nii.gz, truth.nii.gz (named in truth.seg.nrrd, truth.ctbl, truth.itksnap.txt), "
+                  "truth.vtp, params.json")
       ->required();
   cmd->add_option(
          "--shape", a->shape,
@@ -189,7 +192,7 @@ void add_synth_command(CLI::App& app) {
     const std::string image_path = (dir / "image.nii.gz").string(), truth_path = (dir / "truth.nii.gz").string();
     const std::string mesh_path = (dir / "truth.vtp").string(), params_path = (dir / "params.json").string();
     write_volume(image_path, r.image, VoxelType::float32);
-    write_volume(truth_path, r.truth, VoxelType::uint8);
+    write_named_label_map(dir.string(), "truth", r.truth, numbered_values(r.truth), VoxelType::uint8);
     write_mesh(mesh_path, r.truth_mesh);
     const TopologyReport topology = topology_report(r.truth_mesh);
     if (!topology.is_closed_genus0())

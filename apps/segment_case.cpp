@@ -265,11 +265,7 @@ VoxelType label_voxel_type(const SegmentModel& model) {
 void write_label_files(const fs::path& dir, const SegmentModel& model, const Volume& labels) {
   std::vector<NamedValue> named;
   for (std::size_t i = 0; i < model.values.size(); ++i) named.push_back({model.values[i], model.labels[i]});
-  const VoxelType type = label_voxel_type(model);
-  write_volume((dir / "labels.nii.gz").string(), labels, type);
-  write_volume((dir / "labels.seg.nrrd").string(), labels, type, slicer_segmentation_fields(named, labels));
-  write_text_file_atomically((dir / "labels.itksnap.txt").string(), itksnap_label_description(named));
-  write_text_file_atomically((dir / "labels.ctbl").string(), slicer_color_table(named));
+  write_named_label_map(dir.string(), "labels", labels, named, label_voxel_type(model));
 }
 
 // Everything goes to a temporary folder renamed into place at the end.

@@ -5,6 +5,9 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <set>
+
+#include "mesh/atomic_file.h"
 
 namespace mrsnake {
 namespace {
@@ -101,6 +104,24 @@ std::vector<std::pair<std::string, std::string>> slicer_segmentation_fields(cons
                                  {key + "Tags", "Segmentation.Status:completed|"}});
   }
   return fields;
+}
+
+std::vector<NamedValue> numbered_values(const Volume& labels) {
+  std::set<int> values;
+  for (const float v : labels.data)
+    if (v != 0) values.insert(static_cast<int>(v));
+  std::vector<NamedValue> named;
+  for (const int v : values) named.push_back({v, {default_label_name(v), default_label_color(v)}});
+  return named;
+}
+
+void write_named_label_map(const std::string& dir, const std::string& stem, const Volume& labels,
+                           const std::vector<NamedValue>& values, VoxelType type) {
+  const std::string base = dir + "/" + stem;
+  write_volume(base + ".nii.gz", labels, type);
+  write_volume(base + ".seg.nrrd", labels, type, slicer_segmentation_fields(values, labels));
+  write_text_file_atomically(base + ".itksnap.txt", itksnap_label_description(values));
+  write_text_file_atomically(base + ".ctbl", slicer_color_table(values));
 }
 
 }  // namespace mrsnake

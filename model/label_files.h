@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "mesh/image_io.h"
 #include "mesh/volume.h"
 #include "model/label_names.h"
 
@@ -33,5 +34,15 @@ std::string slicer_color_table(const std::vector<NamedValue>& values);
 /// \pre labels.data.size() == labels.num_voxels()
 std::vector<std::pair<std::string, std::string>> slicer_segmentation_fields(const std::vector<NamedValue>& values,
                                                                             const Volume& labels);
+
+/// Every non-zero value of `labels`, in increasing order, with its default name and colour.
+std::vector<NamedValue> numbered_values(const Volume& labels);
+
+/// Writes the label map `labels` as DIR/STEM.nii.gz and, naming its values, DIR/STEM.seg.nrrd
+/// (the same voxels with slicer_segmentation_fields), DIR/STEM.ctbl and DIR/STEM.itksnap.txt.
+/// \pre labels.data.size() == labels.num_voxels(); `values` lists every non-zero value once.
+/// \throw OutputError if a file cannot be written.
+void write_named_label_map(const std::string& dir, const std::string& stem, const Volume& labels,
+                           const std::vector<NamedValue>& values, VoxelType type);
 
 }  // namespace mrsnake
