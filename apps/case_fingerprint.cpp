@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <vector>
 
 #include "mesh/errors.h"
@@ -31,40 +32,57 @@ std::uint64_t hash_file(const fs::path& path, std::uint64_t state) {
   return state;
 }
 
-// The data file a MetaImage (.mhd) or detached NRRD (.nhdr) header names; empty if none or a list.
-fs::path detached_data_file(const fs::path& header) {
+// The data file a MetaImage (.mhd), detached NRRD (.nhdr) or Analyze (.hdr) header puts its
+// voxels in: empty when the header holds them itself; nullopt when it names files this cannot
+// follow (a list, a pattern), so that the image is never taken as unchanged.
+std::optional<fs::path> detached_data_file(const fs::path& header) {
   const std::string ext = header.extension().string();
-  const std::string key = ext == ".mhd" ? "ElementDataFile" : ext == ".nhdr" ? "data file" : "";
-  if (key.empty()) return {};
+  if (ext == ".hdr") return fs::path(header).replace_extension(".img");
+  if (ext != ".mhd" && ext != ".nhdr") return fs::path();
   std::ifstream in(header);
   for (std::string line; std::getline(in, line);) {
-    if (line.rfind(key, 0) != 0) continue;
-    std::string value = line.substr(line.find_first_of("=:", key.size()) + 1);
+    const bool meta = ext == ".mhd" && line.rfind("ElementDataFile", 0) == 0;
+    const bool nrrd = ext == ".nhdr" && (line.rfind("data file:", 0) == 0 || line.rfind("datafile:", 0) == 0);
+    if (!meta && !nrrd) continue;
+    std::string value = line.substr(line.find_first_of(meta ? "=" : ":") + 1);
     value.erase(0, value.find_first_not_of(" \t"));
     while (!value.empty() && (value.back() == '\r' || value.back() == ' ')) value.pop_back();
-    if (value.empty() || value == "LOCAL" || value.rfind("LIST", 0) == 0 || value.find('%') != std::string::npos)
-      return {};
+    if (value == "LOCAL") return fs::path();
+    if (value.empty() || value.rfind("LIST", 0) == 0 || value.find('%') != std::string::npos ||
+        value.find(' ') != std::string::npos)
+      return std::nullopt;
     const fs::path data = value;
     return data.is_absolute() ? data : header.parent_path() / data;
   }
-  return {};
+  return fs::path();
+}
+
+// A DICOM folder's files, in name order.
+// \throw InputError if the folder cannot be listed.
+std::vector<fs::path> folder_files(const std::string& dir) {
+  std::vector<fs::path> files;
+  std::error_code ec;
+  fs::recursive_directory_iterator it(dir, fs::directory_options::skip_permission_denied, ec), end;
+  for (; !ec && it != end; it.increment(ec))
+    if (it->is_regular_file(ec)) files.push_back(it->path());
+  if (ec) throw InputError("cannot list the DICOM folder '" + dir + "' to fingerprint it: " + ec.message());
+  std::sort(files.begin(), files.end());
+  return files;
 }
 
 }  // namespace
 
-std::string image_fingerprint(const std::string& path) {
+std::string image_fingerprint(const std::string& path, const std::string& series) {
   std::error_code ec;
+  std::uint64_t h = hash_text(series + '\0');
   if (fs::is_directory(path, ec)) {  // a DICOM series folder
-    std::vector<fs::path> files;
-    for (const auto& e : fs::recursive_directory_iterator(path, ec))
-      if (e.is_regular_file()) files.push_back(e.path());
-    std::sort(files.begin(), files.end());
-    std::uint64_t h = kFnv1a64Start;
-    for (const fs::path& f : files) h = hash_file(f, hash_text(fs::relative(f, path).string() + '\0', h));
+    for (const fs::path& f : folder_files(path)) h = hash_file(f, hash_text(fs::relative(f, path).string() + '\0', h));
     return model_files::hex64(h);
   }
-  std::uint64_t h = hash_file(path, kFnv1a64Start);
-  if (const fs::path data = detached_data_file(path); !data.empty()) h = hash_file(data, h);
+  h = hash_file(path, h);
+  const std::optional<fs::path> data = detached_data_file(path);
+  if (!data) return "unfollowed-data-files";  // matches no fingerprint of a result: always redone
+  if (!data->empty()) h = hash_file(*data, h);
   return model_files::hex64(h);
 }
 

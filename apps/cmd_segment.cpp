@@ -13,7 +13,7 @@
 #include <thread>
 #include <vector>
 
-#include <unistd.h>
+#include <stdlib.h>
 
 #include "apps/batch_pool.h"
 #include "apps/cli.h"
@@ -158,7 +158,11 @@ std::unique_ptr<TemporaryResult> start_slicer_form(const SlicerOutputs& s, std::
   if (image.empty()) image = s.image;
   if (!output.empty()) return nullptr;
   if (s.labels.empty()) throw CLI::ValidationError("-o", "give the result folder, -o DIR (or LABELS_OUT after IMAGE)");
-  output = (std::filesystem::temp_directory_path() / ("mrsnake-segment-" + std::to_string(::getpid()))).string();
+  std::string pattern = (std::filesystem::temp_directory_path() / "mrsnake-segment-XXXXXX").string();
+  if (::mkdtemp(pattern.data()) == nullptr)
+    throw OutputError("cannot create a temporary result folder in " + std::filesystem::temp_directory_path().string() +
+                      "; give the result folder with -o DIR");
+  output = pattern;
   return std::make_unique<TemporaryResult>(output);
 }
 
@@ -186,8 +190,7 @@ TriMesh all_surfaces(const std::vector<SegmentResult>& results) {
 void finish_slicer_form(const SlicerOutputs& s, const std::string& output, const SegmentModel& model,
                         const SegmentCaseOutcome& outcome) {
   if (!s.labels.empty()) {
-    const int largest = *std::max_element(model.values.begin(), model.values.end());
-    write_volume(s.labels, read_volume(output + "/labels.nii.gz"), largest > 255 ? VoxelType::int16 : VoxelType::uint8);
+    write_volume(s.labels, read_volume(output + "/labels.nii.gz"), label_voxel_type(model));
   }
   if (!s.surfaces.empty()) write_mesh(s.surfaces, all_surfaces(outcome.results));
   for (const std::string& path : {s.labels, s.surfaces, s.return_parameters})
@@ -452,7 +455,7 @@ nlohmann::json batch_row(const std::string& image, const std::string& output, co
   };
   try {
     nlohmann::json earlier;
-    if (resume) earlier = reusable_result(output, model, case_fingerprint(image, model, options));
+    if (resume) earlier = reusable_result(output, model, case_fingerprint(image, "", model, options));
     if (!earlier.is_null()) {
       fill_row_from_report(row, earlier);
       row["resumed"] = true;

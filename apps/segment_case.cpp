@@ -39,7 +39,8 @@ ReplaceableFolder segment_folder() {
       [](const std::string& name) {
         return name == "surface.vtp" || name == "labels.nii.gz" || name == "labels.seg.nrrd" ||
                name == "labels.itksnap.txt" || name == "labels.ctbl" || name == "levels" || name == "surfaces" ||
-               name == "report.json" || name == "report.html" || name == "slices.png";
+               name == "report.json" || name == "report.html" || name == "slices.png" ||
+               name == ".snakemake_timestamp";  // the study workflow's mark on the folder
       },
       "an output of mrsnake segment");
 }
@@ -236,7 +237,7 @@ void write_pages(const fs::path& dir, const SegmentCase& c, const CaseInputs& in
   try {
     const std::vector<std::uint8_t> png = reports::slices_png(page);
     write_text_file_atomically((dir / "slices.png").string(), std::string(png.begin(), png.end()));
-  } catch (const Error& e) {  // a picture for people: its failure does not fail the segmentation
+  } catch (const std::exception& e) {  // a picture for people: its failure does not fail the segmentation
     warn(std::string("slices.png was not written: ") + e.what());
   }
 }
@@ -254,10 +255,6 @@ void write_meshes(const fs::path& dir, const SegmentModel& model, const std::vec
       write_mesh((dir / "levels" / ("level_" + std::to_string(l.level) + ".vtp")).string(), l.surface);
   }
   write_text_file_atomically((dir / "report.json").string(), json_text(rep, 2) + "\n");
-}
-
-VoxelType label_voxel_type(const SegmentModel& model) {
-  return *std::max_element(model.values.begin(), model.values.end()) > 255 ? VoxelType::int16 : VoxelType::uint8;
 }
 
 // The label map with its names and colours: labels.nii.gz, and for 3D Slicer and ITK-SNAP a
@@ -308,8 +305,13 @@ SegmentModel load_segment_model(const std::string& path) {
   return model;
 }
 
-CaseFingerprint case_fingerprint(const std::string& image, const SegmentModel& model, const SegmentOptions& options) {
-  return {image_fingerprint(image), model.fingerprint, options_fingerprint(options), MRSNAKE_VERSION};
+VoxelType label_voxel_type(const SegmentModel& model) {
+  return *std::max_element(model.values.begin(), model.values.end()) > 255 ? VoxelType::int16 : VoxelType::uint8;
+}
+
+CaseFingerprint case_fingerprint(const std::string& image, const std::string& series, const SegmentModel& model,
+                                 const SegmentOptions& options) {
+  return {image_fingerprint(image, series), model.fingerprint, options_fingerprint(options), MRSNAKE_VERSION};
 }
 
 nlohmann::json reusable_result(const std::string& output, const SegmentModel& model, const CaseFingerprint& expected) {
@@ -350,7 +352,7 @@ SegmentCaseOutcome segment_case(const SegmentCase& c, const SegmentModel& model,
   for (std::size_t i = 0; i < model.structures.size(); ++i)
     structures.push_back(structure_report(c, in, model, i, outcome.results[i], map));
   outcome.report = case_report(c, model, model_path, options, structures, shared_seconds, compute_seconds,
-                               case_fingerprint(c.image, model, options));
+                               case_fingerprint(c.image, c.series, model, options));
   if (outcome.report["suspect"].get<bool>())
     warn("the result is doubtful: " + outcome.report["reason"].get<std::string>());
   write_outputs(c, in, model, outcome.results, map, outcome.report, progress);

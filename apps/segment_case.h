@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/case_fingerprint.h"
+#include "mesh/image_io.h"
 #include "mesh/progress.h"
 #include "model/label_names.h"
 #include "snake/segment.h"
@@ -29,6 +30,9 @@ struct SegmentModel {
 /// \throw InputError as load_model_set does.
 SegmentModel load_segment_model(const std::string& path);
 
+/// The voxel type of the model's label map: uint8, or int16 for values above 255.
+VoxelType label_voxel_type(const SegmentModel& model);
+
 /// One image to segment, and where.
 struct SegmentCase {
   std::string image, truth, output;
@@ -46,10 +50,12 @@ struct SegmentCaseOutcome {
 
 /// What a segmentation of `image` with this model and these options records in report.json.
 /// \throw InputError if the image cannot be read.
-CaseFingerprint case_fingerprint(const std::string& image, const SegmentModel& model, const SegmentOptions& options);
+CaseFingerprint case_fingerprint(const std::string& image, const std::string& series, const SegmentModel& model,
+                                 const SegmentOptions& options);
 
 /// The report.json of an earlier result in `output` that is complete (every file segment
-/// writes is there) and was made from `expected`; null otherwise.
+/// writes is there, but for the slices.png thumbnail) and was made from `expected`; null
+/// otherwise, and when `expected` is not comparable.
 nlohmann::json reusable_result(const std::string& output, const SegmentModel& model, const CaseFingerprint& expected);
 
 /// Segments the case into its output folder (replacing only an earlier result of segment):

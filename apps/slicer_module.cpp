@@ -78,8 +78,11 @@ std::string segment_module_xml() {
               "");
   const std::string options =
       flagged("string", "init", "Initialization",
-              "auto, pose, moments, fit, moments+fit, register or register+fit (mrsnake segment --init)", "auto") +
-      flagged("string", "force", "External force", "auto, profile or edge (mrsnake segment --force)", "auto") +
+              "auto, pose, moments, fit, moments+fit, register or register+fit (mrsnake segment --init); empty: "
+              "auto, or the options file's",
+              "") +
+      flagged("string", "force", "External force",
+              "auto, profile or edge (mrsnake segment --force); empty: auto, or the options file's", "") +
       flagged("string", "config", "Options file",
               "A JSON file of segmentation options (docs/segmentation.md), or nothing", "");
   return head("mrsnake segment",

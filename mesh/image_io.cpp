@@ -210,35 +210,62 @@ itk::GDCMSeriesFileNames::Pointer series_names(const std::string& dir) {
   return names;
 }
 
+// Every series of the folder that `names` scanned, each described from its first file's header.
+std::vector<DicomSeries> series_of(itk::GDCMSeriesFileNames* names) {
+  std::vector<DicomSeries> series;
+  for (const std::string& id : names->GetSeriesUIDs()) {
+    DicomSeries s;
+    s.id = s.uid = id;
+    const std::vector<std::string> files = names->GetFileNames(id);
+    s.files = files.size();
+    try {  // a header that cannot be read leaves the description empty, not the folder unreadable
+      auto io = itk::GDCMImageIO::New();
+      io->SetFileName(files.front());
+      io->ReadImageInformation();
+      io->GetValueFromTag("0020|000e", s.uid);
+      io->GetValueFromTag("0008|103e", s.description);
+    } catch (const itk::ExceptionObject&) {
+    }
+    for (std::string* text : {&s.uid, &s.description}) text->erase(text->find_last_not_of(std::string(" \0", 2)) + 1);
+    series.push_back(s);
+  }
+  return series;
+}
+
 // "id (N files, 'description'), ..." for a message.
 std::string series_list(const std::vector<DicomSeries>& series) {
   std::string text;
   for (const DicomSeries& s : series)
-    text += (text.empty() ? "" : ", ") + s.id + " (" + std::to_string(s.files) + " files" +
+    text += (text.empty() ? "" : ", ") + s.uid + " (" + std::to_string(s.files) + " files" +
             (s.description.empty() ? "" : ", '" + s.description + "'") + ")";
   return text;
 }
 
-// The series `wanted` names: its id, or its Series Instance UID (the id's start before the details).
+// The id of the series `wanted` names: by its Series Instance UID, or its id.
 std::string chosen_series(const std::string& dir, const std::vector<DicomSeries>& series, const std::string& wanted) {
   if (series.empty())
     throw InputError("folder '" + dir + "' holds no DICOM series; give an image file or a DICOM folder");
   if (wanted.empty()) {
     if (series.size() == 1) return series.front().id;
     throw InputError("folder '" + dir + "' holds " + std::to_string(series.size()) +
-                     " DICOM series; choose one with --series UID: " + series_list(series));
+                     " DICOM series; choose one by its Series Instance UID (segment --series, build-model "
+                     "--labels-series or --image-series): " +
+                     series_list(series));
   }
   std::vector<std::string> matches;
   for (const DicomSeries& s : series)
-    if (s.id == wanted || s.id.rfind(wanted + ".", 0) == 0) matches.push_back(s.id);
+    if (s.uid == wanted || s.id == wanted) matches.push_back(s.id);
   if (matches.size() == 1) return matches.front();
-  throw InputError("folder '" + dir + "' has " + (matches.empty() ? "no DICOM series " : "several series of ") + "'" +
-                   wanted + "'; its series: " + series_list(series));
+  throw InputError("folder '" + dir + "' has " +
+                   (matches.empty() ? "no DICOM series '" + wanted + "'"
+                                    : std::to_string(matches.size()) + " series of UID '" + wanted +
+                                          "' (of other sizes or orientations)") +
+                   "; its series: " + series_list(series));
 }
 
 Volume read_dicom_series(const std::string& dir, const std::string& wanted) {
   auto names = series_names(dir);
-  const std::string id = chosen_series(dir, list_dicom_series(dir), wanted);
+  const std::string id = chosen_series(dir, series_of(names), wanted);
   auto reader = itk::ImageSeriesReader<FloatImage>::New();
   reader->SetImageIO(itk::GDCMImageIO::New());
   reader->SetFileNames(names->GetFileNames(id));
@@ -281,20 +308,7 @@ std::vector<DicomSeries> list_dicom_series(const std::string& dir) {
   register_image_io();
   try {
     auto names = series_names(dir);
-    std::vector<DicomSeries> series;
-    for (const std::string& id : names->GetSeriesUIDs()) {
-      DicomSeries s;
-      s.id = id;
-      const std::vector<std::string> files = names->GetFileNames(id);
-      s.files = files.size();
-      auto io = itk::GDCMImageIO::New();  // the first file's header: the series' description
-      io->SetFileName(files.front());
-      io->ReadImageInformation();
-      io->GetValueFromTag("0008|103e", s.description);
-      s.description.erase(s.description.find_last_not_of(' ') + 1);
-      series.push_back(s);
-    }
-    return series;
+    return series_of(names);
   } catch (const itk::ExceptionObject& e) {
     throw InputError("cannot read the DICOM folder '" + dir + "': " + one_line_itk_error(e.GetDescription()));
   }

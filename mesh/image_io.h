@@ -16,17 +16,18 @@ enum class VoxelType { uint8, int16, float32 };
 
 /// Reads a 3D scalar image (.nii .nii.gz .nrrd .nhdr .mha .mhd .gipl .gipl.gz) or a DICOM
 /// series (a folder) into a float volume with its origin, spacing and direction. A folder of
-/// several series needs `series`: a series' id as list_dicom_series gives it, or its Series
-/// Instance UID alone.
+/// several series needs `series`: a series' Series Instance UID, or its id as
+/// list_dicom_series gives it.
 /// \throw InputError if the file is missing, unreadable, corrupt, not 3D, not scalar, or
 ///        has non-finite or non-positive spacing; if a folder holds several series and `series`
 ///        names none of them (the message lists them); if `series` is given for a file.
 Volume read_volume(const std::string& path, const std::string& series = "");
 
 /// One DICOM series of a folder: its id (the Series Instance UID, with the details that tell
-/// series of one UID apart), its file count and its Series Description.
+/// series of one UID apart), its Series Instance UID, its file count and its Series Description
+/// (empty when its first file's header cannot be read).
 struct DicomSeries {
-  std::string id, description;
+  std::string id, uid, description;
   std::size_t files = 0;
 };
 

@@ -2,9 +2,11 @@
 """mrsnake as 3D Slicer CLI modules, checked the way Slicer uses them:
   1. each module's `--xml` validates against the Slicer Execution Model's schema (xmllint);
   2. each module runs with the arguments Slicer builds from that XML: every parameter that has
-     a value by its flag, then the indexed ones (images, surfaces) in index order, and
-     --returnparameterfile; the label map and the surfaces it writes are read back (a NRRD
-     reader of the test's own, VTK), and no temporary result folder is left.
+     a value by its flag, then the indexed ones (images, surfaces) in index order; the label
+     map and the surfaces it writes are read back (a NRRD reader of the test's own, VTK), and no
+     temporary result folder is left. segment also gets --returnparameterfile, which Slicer
+     passes to modules that declare scalar outputs (the schema gives these descriptions none),
+     and its file is read back.
 
   slicer_module.py   (MRSNAKE_BIN: the executable; MRSNAKE_SLICER_DIR: the module wrappers;
                       MRSNAKE_SCHEMAS: the folder of ModuleDescription.xsd, default ../shared/schemas)

@@ -64,6 +64,9 @@ TEST(DicomInput, ASeriesIsChosenByItsUidAndAFolderOfSeveralListsThem) {
   const auto series = mrsnake::list_dicom_series(d + "/two");
   ASSERT_EQ(series.size(), 2u);
   for (const auto& s : series) EXPECT_EQ(s.files, image.size[2]) << s.id;
+  EXPECT_TRUE((series[0].uid == kImageUid && series[1].uid == kOtherUid) ||
+              (series[1].uid == kImageUid && series[0].uid == kOtherUid))
+      << series[0].uid << " " << series[1].uid;
 
   ASSERT_EQ(run_mrsnake("-q build-model --labels " + d + "/truth.nii.gz --label 1 --faces 2000 -o " + d + "/m.model")
                 .exit_code,
@@ -71,8 +74,8 @@ TEST(DicomInput, ASeriesIsChosenByItsUidAndAFolderOfSeveralListsThem) {
   const std::string segment = "-q segment --model " + d + "/m.model --image " + d + "/two";
   const auto refused = run_mrsnake(segment + " -o " + d + "/seg-none");
   EXPECT_EQ(refused.exit_code, 3) << refused.output;
-  for (const std::string& needle : {std::string("holds 2 DICOM series; choose one with --series UID"), kImageUid,
-                                    kOtherUid, std::string("'T2 test'"), std::string("'scout'")})
+  for (const std::string& needle : {std::string("holds 2 DICOM series; choose one by its Series Instance UID"),
+                                    kImageUid, kOtherUid, std::string("'T2 test'"), std::string("'scout'")})
     EXPECT_NE(refused.output.find(needle), std::string::npos) << needle << "\n" << refused.output;
   EXPECT_FALSE(fs::exists(dir / "seg-none"));
   EXPECT_EQ(run_mrsnake(segment + " --series 1.2.3.4 -o " + d + "/seg-bad").exit_code, 3);

@@ -410,7 +410,7 @@ TEST_F(Robustness, BatchResumeKeepsOnlyCompleteResultsOfTheSameInputs) {
   }
   EXPECT_EQ(run(" --resume"), (std::vector<bool>{true, false}));
   // An incomplete result is redone; other options redo every image.
-  fs::remove(fs::path(out) / "a" / "slices.png");
+  fs::remove(fs::path(out) / "a" / "surfaces" / "1.vtp");
   EXPECT_EQ(run(" --resume"), (std::vector<bool>{false, true}));
   EXPECT_EQ(run(" --resume --max-iterations 7"), (std::vector<bool>{false, false}));
   std::ifstream csv(fs::path(out) / "batch.csv");

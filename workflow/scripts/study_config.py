@@ -13,6 +13,8 @@ from typing import Dict, List, Optional
 
 # Ids name files and folders: no separators, no leading dot.
 ID_PATTERN = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9._-]*$")
+# Columns of study/volumes.csv that a manifest column may not take.
+RESERVED_COLUMNS = {"status", "suspect", "reason", "error", "exit_code", "compute_seconds", "job_seconds"}
 KNOWN_KEYS = {"reference", "model", "manifest", "output", "mrsnake", "segment_options", "build_options"}
 REFERENCE_KEYS = {"labels", "image", "structures", "label_names"}
 
@@ -99,6 +101,10 @@ def read_manifest(path: str):
     for needed in ("id", "image"):
         if needed not in header:
             raise StudyError(f"the manifest '{path}' has no '{needed}' column; its first line must name id,image[,group,...]")
+    for name in header:
+        if name in RESERVED_COLUMNS or name.startswith(("volume_mm3_", "suspect_")):
+            raise StudyError(f"the manifest '{path}' has a column '{name}', which the study's table uses itself; "
+                             "rename it")
     base = Path(path).parent
     cases, seen = [], set()
     for line, row in enumerate(rows, start=2):

@@ -29,9 +29,12 @@ def png_uri(data: bytes) -> str:
     return "data:image/png;base64," + base64.b64encode(data).decode("ascii")
 
 
-def table_html(frame: pd.DataFrame) -> str:
+def table_html(frame: pd.DataFrame, raw=()) -> str:
+    """An HTML table; every cell escaped but those of the columns in `raw` (pictures)."""
     head = "".join(f"<th>{html.escape(str(c))}</th>" for c in frame.columns)
-    rows = "".join("<tr>" + "".join(f"<td>{cell}</td>" for cell in row) + "</tr>" for row in frame.astype(str).values)
+    rows = "".join("<tr>" + "".join(f"<td>{cell if column in raw else html.escape(cell)}</td>"
+                                     for column, cell in zip(frame.columns, row)) + "</tr>"
+                   for row in frame.astype(str).values)
     return f"<table><tr>{head}</tr>{rows}</table>"
 
 
@@ -122,15 +125,13 @@ def main():
         parts.append("<p class=note>No volume was segmented.</p>")
     parts.append(f"<h2>Doubtful results ({len(flagged)})</h2>")
     if len(flagged):
-        rows = [[html.escape(r.id), html.escape(str(r[group])), html.escape(str(r.reason)), thumbnail(study, r.id)]
-                for _, r in flagged.iterrows()]
-        parts.append(table_html(pd.DataFrame(rows, columns=["id", group, "reason", "slices"])))
+        rows = [[r.id, str(r[group]), str(r.reason), thumbnail(study, r.id)] for _, r in flagged.iterrows()]
+        parts.append(table_html(pd.DataFrame(rows, columns=["id", group, "reason", "slices"]), raw=("slices",)))
     else:
         parts.append("<p class=note>No result was flagged.</p>")
     parts.append(f"<h2>Failed volumes ({len(failed)})</h2>")
     if len(failed):
-        rows = [[html.escape(r.id), html.escape(str(r.image)), r.exit_code, html.escape(str(r.error))]
-                for _, r in failed.iterrows()]
+        rows = [[r.id, str(r.image), r.exit_code, str(r.error)] for _, r in failed.iterrows()]
         parts.append(table_html(pd.DataFrame(rows, columns=["id", "image", "exit code", "error"])))
     else:
         parts.append("<p class=note>Every volume was segmented.</p>")

@@ -2,7 +2,8 @@
 """Snakemake cluster-status command: prints running, success or failed for a Slurm job id.
 
 Asks `scontrol show job` (knows jobs until MinJobAge after they end) and falls back to
-`sacct` (needs accounting); a job neither knows is reported failed. Always exits 0:
+`sacct` (needs accounting); a job that slurmctld no longer knows and accounting does not
+either is reported failed, and one whose state cannot be asked (slurmctld busy) running. Always exits 0:
 Snakemake aborts the whole run when the status command fails.
 """
 import re
@@ -10,7 +11,11 @@ import subprocess
 import sys
 import time
 
-RUNNING = {"PENDING", "RUNNING", "CONFIGURING", "COMPLETING", "SUSPENDED"}
+# Every state from which the job may still run: a "failed" for one of these would let Snakemake
+# resubmit the job while it still writes its outputs.
+RUNNING = {"PENDING", "RUNNING", "CONFIGURING", "COMPLETING", "SUSPENDED", "REQUEUED", "REQUEUE_FED",
+           "REQUEUE_HOLD", "RESIZING", "SIGNALING", "STAGE_OUT", "STOPPED", "RESV_DEL_HOLD", "SPECIAL_EXIT"}
+UNKNOWN = "UNKNOWN"  # slurmctld did not answer: not a verdict
 
 
 def run(*cmd):
@@ -30,7 +35,7 @@ def scontrol_state(jobid):
         if result and "Invalid job id" in result.stderr:
             return None  # slurmctld has forgotten the job (MinJobAge)
         time.sleep(5)
-    return None
+    return UNKNOWN
 
 
 def sacct_state(jobid):
@@ -41,7 +46,11 @@ def sacct_state(jobid):
 
 def main():
     jobid = sys.argv[1].split(";")[0]  # sbatch --parsable prints "id" or "id;cluster"
-    state = scontrol_state(jobid) or sacct_state(jobid)
+    state = scontrol_state(jobid)
+    if state == UNKNOWN:  # ask again at the next check rather than fail a job that may be running
+        state = sacct_state(jobid) or "RUNNING"
+    elif state is None:  # forgotten by slurmctld: accounting may still know
+        state = sacct_state(jobid)
     if state in RUNNING:
         print("running")
     elif state == "COMPLETED":
