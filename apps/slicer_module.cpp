@@ -1,23 +1,13 @@
 #include "apps/slicer_module.h"
 
+#include "apps/report/html.h"
 #include "mesh/atomic_file.h"
 
 namespace mrsnake::cli {
 namespace {
 
-std::string escaped(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
+// XML text: the HTML escape serves (&, <, >, quotes).
+std::string escaped(const std::string& text) { return reports::escape_html(text); }
 
 std::string element(const std::string& tag, const std::string& text) {
   return "      <" + tag + ">" + escaped(text) + "</" + tag + ">\n";

@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "mesh/itk_volume.h"
+
 namespace mrsnake::test {
 namespace {
 
@@ -27,22 +29,7 @@ std::string numbers(const std::vector<double>& values) {
 }
 
 Image3::Pointer to_itk(const Volume& volume) {
-  auto image = Image3::New();
-  Image3::RegionType region;
-  Image3::SpacingType spacing;
-  Image3::PointType origin;
-  Image3::DirectionType direction;
-  for (int d = 0; d < 3; ++d) {
-    region.SetSize(d, volume.size[d]);
-    spacing[d] = volume.spacing[d];
-    origin[d] = volume.origin[d];
-    for (int c = 0; c < 3; ++c) direction(d, c) = volume.direction[3 * d + c];
-  }
-  image->SetRegions(region);
-  image->SetSpacing(spacing);
-  image->SetOrigin(origin);
-  image->SetDirection(direction);
-  image->Allocate();
+  auto image = itk_volume::allocate_like<Image3>(volume);
   for (std::size_t i = 0; i < volume.num_voxels(); ++i)
     image->GetBufferPointer()[i] = static_cast<short>(std::lround(volume.data[i]));
   return image;
