@@ -28,6 +28,7 @@
 #include "mesh/json_options.h"
 #include "mesh/json_text.h"
 #include "mesh/marching_cubes.h"
+#include "mesh/merge.h"
 #include "mesh/mesh_io.h"
 #include "mesh/parallel.h"
 #include "evaluation/evaluate.h"
@@ -166,33 +167,16 @@ std::unique_ptr<TemporaryResult> start_slicer_form(const SlicerOutputs& s, std::
   return std::make_unique<TemporaryResult>(output);
 }
 
-// Every structure's surface as one mesh.
-TriMesh all_surfaces(const std::vector<SegmentResult>& results) {
-  TriMesh all;
-  Eigen::Index nv = 0, nf = 0;
-  for (const SegmentResult& r : results) {
-    nv += r.surface.num_vertices();
-    nf += r.surface.num_faces();
-  }
-  all.V.resize(nv, 3);
-  all.F.resize(nf, 3);
-  nv = nf = 0;
-  for (const SegmentResult& r : results) {
-    all.V.middleRows(nv, r.surface.num_vertices()) = r.surface.V;
-    all.F.middleRows(nf, r.surface.num_faces()) = r.surface.F.array() + static_cast<int>(nv);
-    nv += r.surface.num_vertices();
-    nf += r.surface.num_faces();
-  }
-  return all;
-}
-
-// The positional outputs and the return parameters, from the result folder and the run.
-void finish_slicer_form(const SlicerOutputs& s, const std::string& output, const SegmentModel& model,
-                        const SegmentCaseOutcome& outcome) {
+// The positional outputs and the return parameters, from the run.
+void finish_slicer_form(const SlicerOutputs& s, const SegmentModel& model, const SegmentCaseOutcome& outcome) {
   if (!s.labels.empty()) {
-    write_volume(s.labels, read_volume(output + "/labels.nii.gz"), label_voxel_type(model));
+    write_volume(s.labels, outcome.labels, label_voxel_type(model));
   }
-  if (!s.surfaces.empty()) write_mesh(s.surfaces, all_surfaces(outcome.results));
+  if (!s.surfaces.empty()) {
+    std::vector<const TriMesh*> surfaces;
+    for (const SegmentResult& r : outcome.results) surfaces.push_back(&r.surface);
+    write_mesh(s.surfaces, merged_meshes(surfaces));
+  }
   for (const std::string& path : {s.labels, s.surfaces, s.return_parameters})
     if (!path.empty()) info("wrote " + path);
   if (!s.return_parameters.empty()) {
@@ -262,7 +246,7 @@ void add_segment_command(CLI::App& app) {
           "truth of a model of several must hold the reference's values");
     const SegmentCaseOutcome outcome = segment_case(a->c, model, a->model, options, model.load_seconds, progress);
     const nlohmann::json& rep = outcome.report;
-    finish_slicer_form(a->slicer, a->c.output, model, outcome);
+    finish_slicer_form(a->slicer, model, outcome);
     if (a->json) {
       print_json(rep);
     } else {
@@ -454,15 +438,18 @@ nlohmann::json batch_row(const std::string& image, const std::string& output, co
     row["exit_code"] = static_cast<int>(code);
   };
   try {
+    SegmentCase c;
+    c.image = image;
+    c.output = output;
     nlohmann::json earlier;
-    if (resume) earlier = reusable_result(output, model, case_fingerprint(image, "", model, options));
+    if (resume) {
+      c.fingerprint = case_fingerprint(image, "", model, options);
+      earlier = reusable_result(output, model, *c.fingerprint);
+    }
     if (!earlier.is_null()) {
       fill_row_from_report(row, earlier);
       row["resumed"] = true;
     } else {
-      SegmentCase c;
-      c.image = image;
-      c.output = output;
       fill_row_from_report(row, segment_case(c, model, model_path, options, 0.0, progress).report);
     }
   } catch (const Error& e) {

@@ -347,15 +347,16 @@ SegmentCaseOutcome segment_case(const SegmentCase& c, const SegmentModel& model,
   outcome.results = segment_structures(in.image, model, options, progress, shared_seconds);
   const double compute_seconds = seconds_since(t_compute);
   report(progress, "rasterize", 0.0);
-  const StructureLabelMap map = label_map_and_counts(in.image, model, outcome.results, shared_seconds);
+  StructureLabelMap map = label_map_and_counts(in.image, model, outcome.results, shared_seconds);
   std::vector<nlohmann::json> structures;
   for (std::size_t i = 0; i < model.structures.size(); ++i)
     structures.push_back(structure_report(c, in, model, i, outcome.results[i], map));
   outcome.report = case_report(c, model, model_path, options, structures, shared_seconds, compute_seconds,
-                               case_fingerprint(c.image, c.series, model, options));
+                               c.fingerprint ? *c.fingerprint : case_fingerprint(c.image, c.series, model, options));
   if (outcome.report["suspect"].get<bool>())
     warn("the result is doubtful: " + outcome.report["reason"].get<std::string>());
   write_outputs(c, in, model, outcome.results, map, outcome.report, progress);
+  outcome.labels = std::move(map.labels);
   return outcome;
 }
 

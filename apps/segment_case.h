@@ -4,6 +4,7 @@
 /// `segment-batch` run it: the image prepared and registered once, every structure deformed,
 /// one label map with no voxel claimed twice, a verdict per structure, and the output folder
 /// written atomically.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,8 @@ VoxelType label_voxel_type(const SegmentModel& model);
 struct SegmentCase {
   std::string image, truth, output;
   std::string series;  ///< the DICOM series of a folder `image` that holds several (read_volume)
+  /// case_fingerprint of the image, when the caller has it already (segment-batch --resume).
+  std::optional<CaseFingerprint> fingerprint;
   /// The structure's value in the truth, for a model of one structure; < 0: its own value,
   /// or 1 (as synth writes a truth) when the truth does not hold it. A model of several is
   /// scored on each structure's own value.
@@ -46,6 +49,7 @@ struct SegmentCase {
 struct SegmentCaseOutcome {
   nlohmann::json report;
   std::vector<SegmentResult> results;  ///< per structure
+  Volume labels;                       ///< the label map written as labels.nii.gz
 };
 
 /// What a segmentation of `image` with this model and these options records in report.json.

@@ -14,6 +14,7 @@
 #include "mesh/atomic_file.h"
 #include "mesh/json_text.h"
 #include "mesh/marching_cubes.h"
+#include "mesh/merge.h"
 
 namespace mrsnake::reports {
 namespace {
@@ -57,24 +58,13 @@ std::vector<double> iterations(std::size_t n) {
 
 // Every structure's surface as one mesh, each face carrying its structure's label value.
 TriMesh merged_surfaces(const std::vector<PageStructure>& structures, std::vector<double>& face_values) {
-  Eigen::Index nv = 0, nf = 0;
-  for (const PageStructure& s : structures) {
-    nv += s.surface->num_vertices();
-    nf += s.surface->num_faces();
-  }
-  TriMesh all;
-  all.V.resize(nv, 3);
-  all.F.resize(nf, 3);
+  std::vector<const TriMesh*> surfaces;
   face_values.clear();
-  Eigen::Index v = 0, f = 0;
   for (const PageStructure& s : structures) {
-    all.V.middleRows(v, s.surface->num_vertices()) = s.surface->V;
-    all.F.middleRows(f, s.surface->num_faces()) = s.surface->F.array() + static_cast<int>(v);
-    v += s.surface->num_vertices();
-    f += s.surface->num_faces();
+    surfaces.push_back(s.surface);
     face_values.insert(face_values.end(), s.surface->num_faces(), s.value);
   }
-  return all;
+  return merged_meshes(surfaces);
 }
 
 const char* const kAxisNames[] = {"sagittal (x)", "coronal (y)", "axial (z)"};

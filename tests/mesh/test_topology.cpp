@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "mesh/errors.h"
+#include "mesh/merge.h"
 #include "mesh/mesh_io.h"
 #include "mesh/primitives.h"
 #include "mesh/topology.h"
@@ -130,4 +131,18 @@ TEST(InfoCommand, ReportsGenusAndLoopsAsJson) {
   EXPECT_NE(r.output.find("does not exist"), std::string::npos) << r.output;
   r = test::run_mrsnake("info");
   EXPECT_EQ(r.exit_code, 2) << r.output;
+}
+
+TEST(Topology, MergedMeshesAreSideBySideComponents) {
+  const TriMesh a = icosahedron();
+  TriMesh b = icosahedron();
+  b.V.col(0).array() += 5.0;
+  const TriMesh m = merged_meshes({&a, &b});
+  ASSERT_EQ(m.V.rows(), 24);
+  ASSERT_EQ(m.F.rows(), 40);
+  EXPECT_TRUE(m.V.bottomRows(12).isApprox(b.V));
+  EXPECT_TRUE((m.F.bottomRows(20).array() == b.F.array() + 12).all());
+  const auto r = topology_report(m);
+  EXPECT_EQ(r.components, 2);
+  EXPECT_EQ(r.boundary_edges, 0);
 }
