@@ -70,25 +70,37 @@ void triangulate_samples(const Parameterization& param, const std::vector<bool>&
   base.valence_flips += flip_toward_regular_valence(base.domain, base.faces, rim_min_triangles);
 }
 
-// Flips the edge a-b of f1 = (a, b, c) and f2 = (b, a, d) to c-d when the quad a, d, b, c is
-// convex in D (so neither new face flips), updating the valences. \return whether it flipped.
-bool flip_if_convex_in_domain(const RowMatrixX3d& D, RowMatrixX3i& F, int f1, int f2, int a, int b, int c, int d,
-                              std::vector<int>& valence) {
-  if (!(domain_orientation(D.row(a), D.row(d), D.row(c)) > 0) ||
-      !(domain_orientation(D.row(d), D.row(b), D.row(c)) > 0))
-    return false;
-  F.row(f1) << a, d, c;
-  F.row(f2) << d, b, c;
-  --valence[a];
-  --valence[b];
-  ++valence[c];
-  ++valence[d];
+// The quad a, d, b, c convex in D, so that neither new face flips there.
+FlipGuard convex_in_domain(const RowMatrixX3d& D) {
+  return [&D](const EdgeFlip& e) {
+    return domain_orientation(D.row(e.a), D.row(e.d), D.row(e.c)) > 0 &&
+           domain_orientation(D.row(e.d), D.row(e.b), D.row(e.c)) > 0;
+  };
+}
+
+// Makes the flip if `allowed` lets it, updating the valences. \return whether it flipped.
+bool flip_if_allowed(const EdgeFlip& e, const FlipGuard& allowed, RowMatrixX3i& F, std::vector<int>& valence) {
+  if (!allowed(e)) return false;
+  F.row(e.f1) << e.a, e.d, e.c;
+  F.row(e.f2) << e.d, e.b, e.c;
+  --valence[e.a];
+  --valence[e.b];
+  ++valence[e.c];
+  ++valence[e.d];
   return true;
 }
 
 }  // namespace
 
 int flip_toward_surface_delaunay(const RowMatrixX3d& D, const RowMatrixX3d& X, RowMatrixX3i& F) {
+  return flip_toward_surface_delaunay(X, F, convex_in_domain(D));
+}
+
+int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F, int rim_min_triangles) {
+  return flip_toward_regular_valence(static_cast<int>(D.rows()), F, rim_min_triangles, convex_in_domain(D));
+}
+
+int flip_toward_surface_delaunay(const RowMatrixX3d& X, RowMatrixX3i& F, const FlipGuard& allowed) {
   const auto angle_at = [&](int apex, int a, int b) {
     const Eigen::Vector3d u = X.row(a) - X.row(apex), w = X.row(b) - X.row(apex);
     return std::atan2(u.cross(w).norm(), u.dot(w));
@@ -98,10 +110,11 @@ int flip_toward_surface_delaunay(const RowMatrixX3d& D, const RowMatrixX3d& X, R
     std::map<std::pair<int, int>, std::pair<int, int>> edge_faces;  // directed edge -> (face, corner opposite)
     for (int f = 0; f < F.rows(); ++f)
       for (int k = 0; k < 3; ++k) edge_faces[{F(f, k), F(f, (k + 1) % 3)}] = {f, (k + 2) % 3};
-    std::vector<int> valence(D.rows(), 0);
+    std::vector<int> valence(X.rows(), 0);
     for (const auto& [e, fc] : edge_faces) ++valence[e.first];
     bool changed = false;
     std::vector<bool> touched(F.rows(), false);
+    std::set<std::pair<int, int>> created;  // edge_faces is this pass's: two flips may make one edge
     for (const auto& [e, fc] : edge_faces) {
       const int a = e.first, b = e.second;
       const auto twin = edge_faces.find({b, a});
@@ -109,12 +122,14 @@ int flip_toward_surface_delaunay(const RowMatrixX3d& D, const RowMatrixX3d& X, R
       const int f1 = fc.first, f2 = twin->second.first;
       if (touched[f1] || touched[f2]) continue;
       const int c = F(f1, fc.second), d = F(f2, twin->second.second);
-      if (c == d || edge_faces.count({c, d}) || edge_faces.count({d, c}) || valence[a] <= 3 || valence[b] <= 3)
+      if (c == d || edge_faces.count({c, d}) || edge_faces.count({d, c}) ||
+          created.count({std::min(c, d), std::max(c, d)}) || valence[a] <= 3 || valence[b] <= 3)
         continue;
       // The surface's Delaunay condition: the two angles facing the edge sum to at most pi.
       if (!(angle_at(c, a, b) + angle_at(d, b, a) > 3.14159265358979323846 + 1e-9)) continue;
-      if (!flip_if_convex_in_domain(D, F, f1, f2, a, b, c, d, valence)) continue;
+      if (!flip_if_allowed({f1, f2, a, b, c, d}, allowed, F, valence)) continue;
       touched[f1] = touched[f2] = true;
+      created.insert({std::min(c, d), std::max(c, d)});
       ++flips;
       changed = true;
     }
@@ -123,8 +138,7 @@ int flip_toward_surface_delaunay(const RowMatrixX3d& D, const RowMatrixX3d& X, R
   return flips;
 }
 
-int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F, int rim_min_triangles) {
-  const int n = static_cast<int>(D.rows());
+int flip_toward_regular_valence(int n, RowMatrixX3i& F, int rim_min_triangles, const FlipGuard& allowed) {
   int flips = 0;
   for (int pass = 0; pass < 50; ++pass) {
     std::map<std::pair<int, int>, std::pair<int, int>> edge_faces;  // directed edge -> (face, corner opposite)
@@ -167,7 +181,7 @@ int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F, int rim_
       const double before = dev(a, 0) + dev(b, 0) + dev(c, 0) + dev(d, 0);
       const double after = dev(a, -1) + dev(b, -1) + dev(c, 1) + dev(d, 1);
       if (!(after < before)) continue;
-      if (!flip_if_convex_in_domain(D, F, f1, f2, a, b, c, d, valence)) continue;
+      if (!flip_if_allowed({f1, f2, a, b, c, d}, allowed, F, valence)) continue;
       touched[f1] = touched[f2] = true;
       created.insert({std::min(c, d), std::max(c, d)});
       ++flips;

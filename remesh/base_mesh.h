@@ -4,6 +4,7 @@
 /// sampling), so that protrusions get their own base vertices, triangulated in D by Delaunay
 /// (the convex hull on the sphere, the lifted lower hull in the disk), then edge flips that
 /// bring valences toward 6 (4 on the boundary).
+#include <functional>
 #include <vector>
 
 #include "mesh/trimesh.h"
@@ -30,18 +31,33 @@ struct BaseMesh {
 BaseMesh build_base_mesh(const Parameterization& param, int n0, int rim_min_triangles = 3,
                          const Eigen::VectorXd* density = nullptr);
 
-/// Flips interior edges whose two opposite angles on the surface (the base vertices' 3D
-/// positions X) sum to more than pi, while the quad is convex in D and both ends keep three
-/// edges: the Delaunay triangulation of the samples on the surface, as far as D allows. Needed
-/// where the map is not conformal: a Delaunay triangulation in D is then a poor one on the surface.
+/// An interior edge a-b of the faces f1 = (a, b, c) and f2 = (b, a, d) (up to rotation) that
+/// a flip turns into c-d, making f1 = (a, d, c) and f2 = (d, b, c).
+struct EdgeFlip {
+  int f1, f2, a, b, c, d;
+};
+
+/// Whether a flip may be made. It is asked just before the faces change, so it may also update
+/// what hangs on them (the points located in them, for the base-mesh domain).
+using FlipGuard = std::function<bool(const EdgeFlip&)>;
+
+/// Flips interior edges whose two opposite angles on the surface (the vertices' 3D positions
+/// X) sum to more than pi, where `allowed` lets it and both ends keep three edges: the Delaunay
+/// triangulation of the vertices on the surface, as far as the domain allows. Needed where the
+/// map is not conformal: a Delaunay triangulation in D is then a poor one on the surface.
 /// \return the number of flips made.
+int flip_toward_surface_delaunay(const RowMatrixX3d& X, RowMatrixX3i& F, const FlipGuard& allowed);
+
+/// The same with the quad required convex in D (so that neither new face flips in D).
 int flip_toward_surface_delaunay(const RowMatrixX3d& D, const RowMatrixX3d& X, RowMatrixX3i& F);
 
-/// Flips edges (never boundary edges, never making a flipped triangle in D or a duplicate
-/// edge, never leaving an interior vertex with valence < 3 or a boundary vertex with fewer
-/// than rim_min_triangles triangles) while that lowers sum (valence - 6)² (boundary:
-/// 3·(valence - 4)²).
+/// Flips edges (never boundary edges, never making a duplicate edge, never leaving an interior
+/// vertex with valence < 3 or a boundary vertex with fewer than rim_min_triangles triangles)
+/// where `allowed` lets it, while that lowers sum (valence - 6)² (boundary: 3·(valence - 4)²).
 /// \return the number of flips made.
+int flip_toward_regular_valence(int vertices, RowMatrixX3i& F, int rim_min_triangles, const FlipGuard& allowed);
+
+/// The same with the quad required convex in D (so that neither new face flips in D).
 int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F, int rim_min_triangles = 3);
 
 }  // namespace mrsnake

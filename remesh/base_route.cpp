@@ -9,6 +9,7 @@
 #include "mesh/errors.h"
 #include "mesh/parallel.h"
 #include "remesh/base_domain.h"
+#include "remesh/base_flips.h"
 #include "remesh/base_levels.h"
 #include "remesh/base_lift.h"
 #include "remesh/domain.h"
@@ -26,6 +27,7 @@ using namespace remesh_stages;
 // core meanwhile.
 struct MappedOnBase {
   MapsParameterization maps;
+  BaseFlipStats flips;
   std::shared_ptr<SurfaceLocator> locator;
 };
 
@@ -35,7 +37,10 @@ MappedOnBase map_onto_base(const PreparedInput& input, int base_vertices, bool n
   MapsOptions options;
   options.base_vertices = base_vertices;
   MappedOnBase m;
-  m.locator = map_beside_locator(input, needs_locator, [&] { m.maps = maps_parameterize(input.work, options); });
+  m.locator = map_beside_locator(input, needs_locator, [&] {
+    m.maps = maps_parameterize(input.work, options);
+    m.flips = flip_base_edges(m.maps);
+  });
   return m;
 }
 
@@ -64,6 +69,8 @@ nlohmann::json base_summary(const MappedOnBase& mapped, const BaseDomain& domain
   s["base_faces"] = mapped.maps.base.num_faces();
   s["removed_vertices"] = mapped.maps.removed_vertices;
   s["refused_removals"] = mapped.maps.refused_removals;
+  s["surface_flips"] = mapped.flips.delaunay_flips;
+  s["valence_flips"] = mapped.flips.valence_flips;
   s["unmapped_triangles"] = lift.unmapped_triangles();
   s["base_offset_edges"] = base_offset(input.work, mapped.maps, domain);
   s["input_faces"] = input.original.num_faces();
@@ -204,10 +211,11 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
 RemeshResult remesh_on_base_mesh(const TriMesh& input, const RemeshOptions& options) {
   RemeshResult result;
   const auto start = Clock::now();
-  const Resolution resolution = initial_resolution(options);
+  Resolution resolution = initial_resolution(options);
   PreparedInput prepared = prepare_input(input, options.simplify, resolution, options.progress, start);
-  Eigen::VectorXd wanted = curvature_density(vertex_curvature(prepared.work, 8), options.sizing.curvature_weight,
-                                             options.sizing.curvature_exponent);
+  // MAPS spreads the base by its removal order, so only the grown size and density are used.
+  Eigen::VectorXd wanted =
+      sizing_fields(prepared.work, options.sizing, options.base, options.levels != 0, resolution).wanted;
   const long long finest_faces = 2LL * (resolution.base_vertices - 2) << (2 * resolution.levels);
   refine_coarse_input(prepared, finest_faces, wanted);
   const bool needs_locator = prepared.simplified || options.relax == RelaxMode::all_vertices || options.compute_stats ||

@@ -35,55 +35,6 @@ namespace {
 
 using namespace remesh_stages;
 
-// Edge rings in about one base spacing: sqrt(input vertices / base vertices).
-int base_spacing_rings(const TriMesh& surface, int n0) {
-  return static_cast<int>(std::lround(std::sqrt(surface.num_vertices() / static_cast<double>(n0))));
-}
-
-// The wanted 3D point densities: `wanted` for the levels' relaxation, `base_density` for the
-// base vertices' spread (both relative, >= 1 where nothing asks for more).
-struct SizingFields {
-  Eigen::VectorXd wanted;
-  Eigen::VectorXd base_density;
-};
-
-// Curvature sizing. Where the bend bound (remesh/sizing.h) asks for more than half of the base
-// vertices (thin tubes, many tips), the base grows 4x and the hierarchy loses a level, unless
-// the levels were given or there is only one. The grown base is spread by the bound, and the
-// relaxation's density raised by the same factor, so that the levels keep the base's grading.
-SizingFields sizing_fields(const TriMesh& surface, const SizingOptions& sizing, const BaseMeshOptions& base,
-                           bool levels_given, Resolution& resolution) {
-  int& levels = resolution.levels;
-  int& n0 = resolution.base_vertices;
-  const int n = surface.num_vertices();
-  const Eigen::VectorXd kappa = vertex_curvature(surface, 8);
-  SizingFields s{curvature_density(kappa, sizing.curvature_weight, sizing.curvature_exponent),
-                 Eigen::VectorXd::Ones(n)};
-  // Averaged over about a base spacing (sqrt(n / n0) edge rings): the base follows where the
-  // surface bends at its own scale, not voxel steps.
-  if (base.density_exponent > 0) {
-    const int passes = base.density_smoothing < 0 ? base_spacing_rings(surface, n0) : base.density_smoothing;
-    s.base_density = smooth_vertex_field(surface, s.wanted, passes).array().pow(base.density_exponent).matrix();
-  }
-  const double max_bend = base.max_bend;
-  if (!(max_bend > 0)) return s;
-  const Eigen::VectorXd bend_kappa = smooth_vertex_field(surface, kappa, base_spacing_rings(surface, n0));
-  const double bound_points = bend_bound_points(surface, bend_kappa, max_bend);
-  // Below that, the curvature sizing alone spreads the base: the bound moved base vertices
-  // onto small bent features such as a bear's ears (Q mean -0.013 at 16k faces).
-  if (levels_given || levels == 1 || bound_points <= 0.5 * n0) return s;
-  // Once: a base 16x larger leaves a hierarchy of two levels with 10 % irregular vertices (the
-  // octopus at 16k faces), and a marching-cubes staircase's voxel steps, which the curvature
-  // measure sees as bends, ask for it too (the liver).
-  n0 = 4 * n0 - 6;
-  --levels;
-  const Eigen::VectorXd grown_kappa = smooth_vertex_field(surface, kappa, base_spacing_rings(surface, n0));
-  const Eigen::VectorXd bounded = bend_bounded_density(surface, s.base_density, grown_kappa, n0, max_bend);
-  s.wanted = s.wanted.cwiseProduct(bounded.cwiseQuotient(s.base_density));
-  s.base_density = bounded;
-  return s;
-}
-
 void check_resolution_and_relaxation(const RemeshOptions& o, const std::string& at) {
   require_in(at + "levels", o.levels, 0, 12);
   if (o.levels == 0) require_at_least(at + "target_faces", o.target_faces, 16);

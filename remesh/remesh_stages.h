@@ -33,6 +33,21 @@ void choose_resolution(int target_faces, int& levels, int& n0);
 /// The levels L and the base size n0 that the options ask for.
 Resolution initial_resolution(const RemeshOptions& options);
 
+/// The wanted 3D point densities: `wanted` for the levels' relaxation, `base_density` for the
+/// base vertices' spread (both relative, >= 1 where nothing asks for more).
+struct SizingFields {
+  Eigen::VectorXd wanted;
+  Eigen::VectorXd base_density;
+};
+
+/// Curvature sizing on `surface` (the parameterized input). Where the bend bound
+/// (remesh/sizing.h) asks for more than half of the base vertices (thin tubes, many tips), the
+/// base grows 4x and the hierarchy loses a level, unless the levels were given or there is
+/// only one. The grown base is spread by the bound, and the relaxation's density raised by the
+/// same factor, so that the levels keep the base's grading.
+SizingFields sizing_fields(const TriMesh& surface, const SizingOptions& sizing, const BaseMeshOptions& base,
+                           bool levels_given, Resolution& resolution);
+
 /// The input as it is parameterized: the original without unreferenced vertices, or a
 /// simplification of it when it is much finer than the finest level.
 struct PreparedInput {

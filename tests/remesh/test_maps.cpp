@@ -14,6 +14,7 @@
 #include "mesh/errors.h"
 #include "mesh/primitives.h"
 #include "mesh/topology.h"
+#include "remesh/base_flips.h"
 #include "remesh/maps.h"
 #include "tests/remesh/remesh_shapes.h"
 
@@ -278,6 +279,62 @@ TEST(Maps, KeepsFeatureVertices) {
   const MapsParameterization maps = maps_parameterize(input, options);
   for (int v : options.feature_vertices)
     EXPECT_NE(std::find(maps.base_vertex.begin(), maps.base_vertex.end(), v), maps.base_vertex.end()) << v;
+}
+
+// sum (valence - 6)² over K's vertices (a closed K).
+int valence_deviation(const TriMesh& K) {
+  std::vector<int> valence(K.num_vertices(), 0);
+  for (int f = 0; f < K.num_faces(); ++f)
+    for (int j = 0; j < 3; ++j) ++valence[K.F(f, j)];
+  int sum = 0;
+  for (int v : valence) sum += (v - 6) * (v - 6);
+  return sum;
+}
+
+// A flat square grid of n x n cells in z = 0, its vertices nudged in the plane, faces
+// counter-clockwise seen from +z: a disk on which a point of K is exactly a point of the plane.
+TriMesh flat_grid(int n) {
+  TriMesh m;
+  m.V.resize((n + 1) * (n + 1), 3);
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const bool rim = i == 0 || j == 0 || i == n || j == n;
+      const double nudge = rim ? 0.0 : 0.25;
+      m.V.row(j * (n + 1) + i) << i + nudge * std::sin(1.7 * i + 0.3 * j), j + nudge * std::cos(0.9 * i - 1.3 * j), 0.0;
+    }
+  m.F.resize(2 * n * n, 3);
+  for (int j = 0, f = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int v00 = j * (n + 1) + i, v10 = v00 + 1, v01 = v00 + n + 1, v11 = v01 + 1;
+      m.F.row(f++) << v00, v10, v11;
+      m.F.row(f++) << v00, v11, v01;
+    }
+  return m;
+}
+
+// On a flat K the unfolding of a flip's quad is exact, so every point of K stays where it was:
+// the flips locate the points of the two faces again without moving them.
+TEST(BaseFlips, LocateThePointsOfAFlatBaseAgainWithoutMovingThem) {
+  const TriMesh input = flat_grid(24);
+  MapsParameterization maps = simplify(input, 60);
+  std::vector<Eigen::Vector3d> before(input.num_vertices());
+  for (int v = 0; v < input.num_vertices(); ++v) before[v] = on_base(maps, v);
+  const BaseFlipStats stats = flip_base_edges(maps);
+  EXPECT_GT(stats.delaunay_flips + stats.valence_flips, 0);
+  expect_oriented_manifold(maps.base, false);
+  expect_valid_locations(input, maps);
+  for (int v = 0; v < input.num_vertices(); ++v) EXPECT_LT((on_base(maps, v) - before[v]).norm(), 1e-9) << v;
+}
+
+// On a long capsule the flips make K more regular and leave the map sound and local.
+TEST(BaseFlips, MakeACapsulesBaseMoreRegularAndKeepTheMapSound) {
+  const TriMesh input = test::capsule(15.0);
+  MapsParameterization maps = simplify(input, 60);
+  const int deviation_before = valence_deviation(maps.base);
+  const BaseFlipStats stats = flip_base_edges(maps);
+  EXPECT_GT(stats.valence_flips, 0);
+  EXPECT_LT(valence_deviation(maps.base), deviation_before);
+  expect_sound_closed_map(input, maps, 60);
 }
 
 TEST(Maps, RefusesMeshesThatAreNeitherADiskNorASphere) {
