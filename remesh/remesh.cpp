@@ -349,12 +349,8 @@ RemeshLevel build_level(const LevelContext& ctx, const RemeshOptions& options, i
   return level;
 }
 
-}  // namespace
-
-RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
-  check_options(options);
-  if (input.empty()) throw InputError("the mesh has no faces");
-  if (options.domain == ParameterDomain::base_mesh) return remesh_on_base_mesh(input, options);
+// The sphere route: the input mapped onto the unit sphere or disk, the base in D, the levels.
+RemeshResult remesh_on_sphere(const TriMesh& input, const RemeshOptions& options) {
   RemeshResult result;
   const auto start = Clock::now();
   Resolution resolution = initial_resolution(options);
@@ -390,6 +386,68 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
     report(options.progress, "level " + std::to_string(j), 1.0);
   }
   return result;
+}
+
+// What the automatic domain compares of two finest levels.
+struct FinestLevelScore {
+  int self_intersections = 0;
+  double q_mean = 0;
+};
+
+FinestLevelScore finest_level_score(const RemeshResult& r) {
+  const TriMesh finest = r.mesh(static_cast<int>(r.levels.size()) - 1);
+  return {count_self_intersections(finest), mesh_quality(finest).q_mean};
+}
+
+nlohmann::json score_json(const FinestLevelScore& s) {
+  return {{"self_intersections", s.self_intersections}, {"q_mean", s.q_mean}};
+}
+
+// The hierarchical map stood in for the one-chart sphere map, which failed: the shape has
+// protrusions that one chart squeezes, and the base mesh may hold it better.
+bool on_the_hierarchical_map(const RemeshResult& r) {
+  return r.domain == "sphere" && r.parameterization.value("sphere_map", "") == "hierarchical";
+}
+
+// Both domains' finest levels compared: fewer self-intersections, then the higher mean
+// quality. The base mesh also failing keeps the sphere's result.
+RemeshResult better_of_both_domains(RemeshResult on_sphere, const TriMesh& input, const RemeshOptions& options) {
+  const auto start = Clock::now();
+  const FinestLevelScore sphere_score = finest_level_score(on_sphere);
+  nlohmann::json choice = {{"sphere", score_json(sphere_score)},
+                           {"sphere_map_fallback", on_sphere.parameterization.value("sphere_map_fallback", "")}};
+  RemeshResult chosen;
+  try {
+    RemeshResult on_base = remesh_on_base_mesh(input, options);
+    const FinestLevelScore base_score = finest_level_score(on_base);
+    choice["base_mesh"] = score_json(base_score);
+    const bool base_wins = base_score.self_intersections != sphere_score.self_intersections
+                               ? base_score.self_intersections < sphere_score.self_intersections
+                               : base_score.q_mean > sphere_score.q_mean;
+    chosen = base_wins ? std::move(on_base) : std::move(on_sphere);
+  } catch (const AlgorithmError& e) {
+    choice["base_mesh"] = {{"error", e.what()}};
+    chosen = std::move(on_sphere);
+  }
+  choice["chosen"] = chosen.domain;
+  choice["rule"] = "fewer self-intersections at the finest level, then the higher mean quality";
+  choice["seconds"] = seconds_since(start);  // the second domain and the comparison
+  chosen.parameterization["domain_choice"] = choice;
+  return chosen;
+}
+
+}  // namespace
+
+RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
+  check_options(options);
+  if (input.empty()) throw InputError("the mesh has no faces");
+  if (options.domain == ParameterDomain::base_mesh) return remesh_on_base_mesh(input, options);
+  RemeshResult on_sphere = remesh_on_sphere(input, options);
+  // The paper's variants (--strict, --no-relax) stay on the sphere, as the paper builds them.
+  if (options.domain == ParameterDomain::sphere || options.relax != RelaxMode::all_vertices ||
+      !on_the_hierarchical_map(on_sphere))
+    return on_sphere;
+  return better_of_both_domains(std::move(on_sphere), input, options);
 }
 
 nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& options) {

@@ -32,6 +32,10 @@ enum class RelaxMode {
 
 /// The parameter domain D on which the levels are built and relaxed.
 enum class ParameterDomain {
+  /// `sphere`; where the one-chart map of a closed surface fails and the hierarchical map
+  /// stands in (protrusions: legs, fingers, horns), `base_mesh` is built too, and the finest
+  /// level with fewer self-intersections, then the higher mean quality, is kept (default).
+  automatic,
   /// The input mapped as a whole onto the unit sphere (closed) or the unit disk (a disk):
   /// remesh/parameterization.h.
   sphere,
@@ -131,7 +135,7 @@ struct RemeshOptions {
   /// Number of base vertices when `levels` is given (ignored with target_faces).
   int base_vertices = 32;
   RelaxMode relax = RelaxMode::all_vertices;
-  ParameterDomain domain = ParameterDomain::sphere;
+  ParameterDomain domain = ParameterDomain::automatic;
   /// How a closed genus-0 input is mapped onto the sphere (remesh/parameterization.h).
   SphereMap sphere_map = SphereMap::automatic;
   SimplifyOptions simplify;
@@ -173,7 +177,7 @@ struct RemeshLevel {
 struct RemeshResult {
   SubdivisionConnectivity connectivity;  ///< faces[j] = subdivide_connectivity(F0, n0, L).faces[j]
   std::vector<RemeshLevel> levels;       ///< levels[j] for j = 0..L
-  /// "sphere" or "disk".
+  /// "sphere", "disk" or "base_mesh".
   std::string domain;
   /// Summary of the parameterization: method, distortion range, seconds.
   nlohmann::json parameterization;

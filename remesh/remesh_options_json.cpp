@@ -19,7 +19,8 @@ const std::pair<SphereMap, const char*> kSphereMapNames[] = {{SphereMap::automat
                                                              {SphereMap::two_halves, "two_halves"},
                                                              {SphereMap::hierarchical, "hierarchical"}};
 
-const std::pair<ParameterDomain, const char*> kDomainNames[] = {{ParameterDomain::sphere, "sphere"},
+const std::pair<ParameterDomain, const char*> kDomainNames[] = {{ParameterDomain::automatic, "automatic"},
+                                                                {ParameterDomain::sphere, "sphere"},
                                                                 {ParameterDomain::base_mesh, "base_mesh"}};
 }  // namespace
 

@@ -314,8 +314,9 @@ std::string write_tube_labels(const std::filesystem::path& dir, int length, doub
 TEST(BuildModelCli, LongTubesArePuncturedInTheMiddleAndTheTooLongMappedHierarchically) {
   // A one-chart sphere map squeezes a tube's far end exponentially in its length over its
   // radius. Punctured near the middle, a 70-voxel tube of radius 2.5 stays within the limit
-  // (12 orders of magnitude) and keeps the conformal map. A 100-voxel one does not: its model
-  // is built on the hierarchical map, with no flipped triangle at any level.
+  // (12 orders of magnitude) and keeps the conformal map. A 100-voxel one does not: the
+  // hierarchical map stands in, the base-mesh domain is built too, and the better of the two
+  // is kept, with no flipped triangle at any level.
   const auto dir = scratch_dir("build-model-cli-tube");
   const std::string model = (dir / "tube.model").string();
   const auto built =
@@ -333,9 +334,11 @@ TEST(BuildModelCli, LongTubesArePuncturedInTheMiddleAndTheTooLongMappedHierarchi
                              " --faces 2048" + config_arg(dir, "mc12", {{"surface", {{"mc_spacing_mm", 1.2}}}}));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const ShapeModel long_tube = load_model_set(model, {true}).structures.at(0).model;
-  const nlohmann::json& param = long_tube.remesh_quality["parameterization"];
-  EXPECT_EQ(param["sphere_map"], "hierarchical");
-  EXPECT_NE(param.value("sphere_map_fallback", std::string()).find("orders of magnitude"), std::string::npos) << param;
+  const nlohmann::json& choice = long_tube.remesh_quality["parameterization"]["domain_choice"];
+  EXPECT_NE(choice.value("sphere_map_fallback", std::string()).find("orders of magnitude"), std::string::npos)
+      << choice;
+  EXPECT_TRUE(choice["base_mesh"].contains("q_mean")) << choice;
+  EXPECT_EQ(long_tube.remesh_quality["domain"], choice["chosen"]);
   for (const auto& level : long_tube.remesh_quality["per_level"]) EXPECT_EQ(level["flipped_triangles"], 0) << level;
   std::filesystem::remove_all(dir);
 }

@@ -228,6 +228,31 @@ TEST(BaseDomainRemesh, ADiskRimSlidesAlongTheInputRimToEvenLengths) {
   EXPECT_LT(*longest / *shortest, 2.2) << lengths.size() << " rim edges";
 }
 
+// The automatic domain (the default): a capsule long enough that the one-chart sphere map
+// fails is built on both domains, and the kept one is the better by the rule it records; an
+// ellipsoid, which one chart holds, stays on the sphere with no second build.
+TEST(AutomaticDomain, AShapeOneChartCannotHoldKeepsTheBetterOfBothDomains) {
+  RemeshOptions o;
+  o.target_faces = 4096;
+  const TriMesh capsule = test::capsule(40.0);
+  const RemeshResult r = remesh(capsule, o);
+  const nlohmann::json& choice = r.parameterization["domain_choice"];
+  ASSERT_TRUE(choice.is_object()) << r.parameterization;
+  EXPECT_NE(choice["sphere_map_fallback"].get<std::string>().find("hierarchical"), std::string::npos);
+  EXPECT_EQ(choice["chosen"], r.domain);
+  const nlohmann::json &kept = choice[r.domain], &other = choice[r.domain == "sphere" ? "base_mesh" : "sphere"];
+  const TriMesh finest = r.mesh(static_cast<int>(r.levels.size()) - 1);
+  EXPECT_EQ(kept["self_intersections"].get<int>(), count_self_intersections(finest));
+  EXPECT_DOUBLE_EQ(kept["q_mean"].get<double>(), mesh_quality(finest).q_mean);
+  const int kept_x = kept["self_intersections"], other_x = other["self_intersections"];
+  EXPECT_TRUE(kept_x < other_x || (kept_x == other_x && kept["q_mean"] >= other["q_mean"])) << choice;
+  expect_valid_hierarchy(r, capsule);
+
+  const RemeshResult plain = remesh(test::ellipsoid(3), o);
+  EXPECT_EQ(plain.domain, "sphere");
+  EXPECT_FALSE(plain.parameterization.contains("domain_choice"));
+}
+
 TEST(BaseDomainRemesh, OptionNameRoundTripsThroughJson) {
   RemeshOptions o = base_domain_options(1000);
   const nlohmann::json j = o;
