@@ -83,7 +83,8 @@ class BaseFlipper {
  public:
   BaseFlipper(MapsParameterization& maps, const BaseFlipOptions& options)
       : maps_(maps), options_(options), points_(maps.base.num_faces()) {
-    for (std::size_t p = 0; p < maps.location.size(); ++p) points_[maps.location[p].face].push_back(static_cast<int>(p));
+    for (std::size_t p = 0; p < maps.location.size(); ++p)
+      points_[maps.location[p].face].push_back(static_cast<int>(p));
   }
 
   BaseFlipStats run() {

@@ -410,7 +410,8 @@ bool on_the_hierarchical_map(const RemeshResult& r) {
 }
 
 // Both domains' finest levels compared: fewer self-intersections, then the higher mean
-// quality. The base mesh also failing keeps the sphere's result.
+// quality. If the base mesh fails, for any reason, the sphere's valid result is kept and the
+// failure recorded.
 RemeshResult better_of_both_domains(RemeshResult on_sphere, const TriMesh& input, const RemeshOptions& options) {
   const auto start = Clock::now();
   const FinestLevelScore sphere_score = finest_level_score(on_sphere);
@@ -425,7 +426,7 @@ RemeshResult better_of_both_domains(RemeshResult on_sphere, const TriMesh& input
                                ? base_score.self_intersections < sphere_score.self_intersections
                                : base_score.q_mean > sphere_score.q_mean;
     chosen = base_wins ? std::move(on_base) : std::move(on_sphere);
-  } catch (const AlgorithmError& e) {
+  } catch (const std::exception& e) {
     choice["base_mesh"] = {{"error", e.what()}};
     chosen = std::move(on_sphere);
   }
