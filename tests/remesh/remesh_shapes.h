@@ -1,6 +1,6 @@
 #pragma once
 // Small analytic inputs shared by the remesher's tests: a closed genus-0 surface with uneven
-// stretch, a disk, and a sheared layout of the sphere D.
+// stretch, disks (a cap, a flat grid), a capsule, and a sheared layout of the sphere D.
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -33,6 +33,27 @@ inline TriMesh spherical_cap(int levels) {
   TriMesh cap = extract_faces(s, faces);
   cap.V.col(0) *= 2.0;
   return cap;
+}
+
+// A flat square grid of n x n cells in z = 0, vertex (i, j) at index j·(n+1) + i, faces
+// counter-clockwise seen from +z. `nudge` moves the interior vertices in the plane by up to that
+// much (deterministically), so that no four vertices are cocircular.
+inline TriMesh flat_grid(int n, double nudge = 0.0) {
+  TriMesh m;
+  m.V.resize((n + 1) * (n + 1), 3);
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const double d = i == 0 || j == 0 || i == n || j == n ? 0.0 : nudge;
+      m.V.row(j * (n + 1) + i) << i + d * std::sin(1.7 * i + 0.3 * j), j + d * std::cos(0.9 * i - 1.3 * j), 0.0;
+    }
+  m.F.resize(2 * n * n, 3);
+  for (int j = 0, f = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int v00 = j * (n + 1) + i, v10 = v00 + 1, v01 = v00 + n + 1, v11 = v01 + 1;
+      m.F.row(f++) << v00, v10, v11;
+      m.F.row(f++) << v00, v11, v01;
+    }
+  return m;
 }
 
 // A capsule along z: a tube of radius 1 and the given length with hemispherical caps, `around`

@@ -291,31 +291,10 @@ int valence_deviation(const TriMesh& K) {
   return sum;
 }
 
-// A flat square grid of n x n cells in z = 0, its vertices nudged in the plane, faces
-// counter-clockwise seen from +z: a disk on which a point of K is exactly a point of the plane.
-TriMesh flat_grid(int n) {
-  TriMesh m;
-  m.V.resize((n + 1) * (n + 1), 3);
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) {
-      const bool rim = i == 0 || j == 0 || i == n || j == n;
-      const double nudge = rim ? 0.0 : 0.25;
-      m.V.row(j * (n + 1) + i) << i + nudge * std::sin(1.7 * i + 0.3 * j), j + nudge * std::cos(0.9 * i - 1.3 * j), 0.0;
-    }
-  m.F.resize(2 * n * n, 3);
-  for (int j = 0, f = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      const int v00 = j * (n + 1) + i, v10 = v00 + 1, v01 = v00 + n + 1, v11 = v01 + 1;
-      m.F.row(f++) << v00, v10, v11;
-      m.F.row(f++) << v00, v11, v01;
-    }
-  return m;
-}
-
 // On a flat K the unfolding of a flip's quad is exact, so every point of K stays where it was:
 // the flips locate the points of the two faces again without moving them.
 TEST(BaseFlips, LocateThePointsOfAFlatBaseAgainWithoutMovingThem) {
-  const TriMesh input = flat_grid(24);
+  const TriMesh input = test::flat_grid(24, 0.25);
   MapsParameterization maps = simplify(input, 60);
   std::vector<Eigen::Vector3d> before(input.num_vertices());
   for (int v = 0; v < input.num_vertices(); ++v) before[v] = on_base(maps, v);

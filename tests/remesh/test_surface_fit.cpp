@@ -13,6 +13,7 @@
 #include "mesh/quality.h"
 #include "remesh/remesh.h"
 #include "remesh/surface_fit.h"
+#include "tests/remesh/remesh_shapes.h"
 #include "tests/test_support.h"
 
 namespace mrsnake {
@@ -67,18 +68,7 @@ TEST(SurfaceFit, MovesAnIcosphereOutwardByThreeQuartersOfTheCentroidSag) {
 
 // A flat grid on a flat input has nothing to correct: no vertex moves.
 TEST(SurfaceFit, LeavesAMeshOnAPlaneWhereItIs) {
-  const int k = 8;
-  TriMesh grid;
-  grid.V.resize((k + 1) * (k + 1), 3);
-  for (int i = 0; i <= k; ++i)
-    for (int j = 0; j <= k; ++j) grid.V.row(i * (k + 1) + j) << i, j, 0;
-  grid.F.resize(2 * k * k, 3);
-  for (int i = 0, f = 0; i < k; ++i)
-    for (int j = 0; j < k; ++j) {
-      const int a = i * (k + 1) + j, b = a + 1, c = a + k + 1, d = c + 1;
-      grid.F.row(f++) << a, c, d;
-      grid.F.row(f++) << a, d, b;
-    }
+  const TriMesh grid = test::flat_grid(8);
   TriMesh plane;  // larger, so that every closest point is inside it
   plane.V.resize(4, 3);
   plane.V << -5, -5, 0, 20, -5, 0, 20, 20, 0, -5, 20, 0;
