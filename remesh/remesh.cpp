@@ -452,9 +452,10 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   if (options.domain == ParameterDomain::base_mesh) return remesh_on_base_mesh(input, options);
   const auto start = Clock::now();
   RemeshResult on_sphere = remesh_on_sphere(input, options);
-  // The paper's variants (--strict, --no-relax) stay on the sphere, as the paper builds them.
+  // The paper's variants (--strict, --no-relax) stay on the sphere, as the paper builds them,
+  // and so does a sphere map the caller chose.
   if (options.domain == ParameterDomain::sphere || options.relax != RelaxMode::all_vertices ||
-      !on_the_hierarchical_map(on_sphere))
+      options.sphere_map != SphereMap::automatic || !on_the_hierarchical_map(on_sphere))
     return on_sphere;
   return better_of_both_domains(std::move(on_sphere), seconds_since(start), input, options);
 }

@@ -32,9 +32,10 @@ enum class RelaxMode {
 
 /// The parameter domain D on which the levels are built and relaxed.
 enum class ParameterDomain {
-  /// `sphere`; where the one-chart map of a closed surface fails and the hierarchical map
-  /// stands in (protrusions: legs, fingers, horns), `base_mesh` is built too, and the finest
-  /// level with fewer self-intersections, then the higher mean quality, is kept (default).
+  /// `sphere`; where the one-chart map of a closed surface fails and the automatic sphere map
+  /// falls back on the hierarchical one (protrusions: legs, fingers, horns), `base_mesh` is
+  /// built too, and the finest level with fewer self-intersections, then the higher mean
+  /// quality, is kept (default).
   automatic,
   /// The input mapped as a whole onto the unit sphere (closed) or the unit disk (a disk):
   /// remesh/parameterization.h.
