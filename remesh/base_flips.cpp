@@ -57,8 +57,9 @@ double fold_deg(const RowMatrixX3d& X, int u0, int u1, int u2, int w0, int w1, i
   return std::acos(c) * 180.0 / 3.14159265358979323846;
 }
 
-// Frey–Borouchaki quality 4·sqrt(3)·area / (sum of squared edge lengths), 1 for equilateral.
-double quality(const RowMatrixX3d& X, int u, int v, int w) {
+// The mean-ratio quality 4·sqrt(3)·area / (sum of squared edge lengths), 1 for equilateral:
+// smooth in the vertices, so a small loss reads as a small loss (not mesh/quality.h's Q).
+double mean_ratio(const RowMatrixX3d& X, int u, int v, int w) {
   const Vector3d p = X.row(u), q = X.row(v), r = X.row(w);
   const double squares = (q - p).squaredNorm() + (r - q).squaredNorm() + (p - r).squaredNorm();
   return squares > 0 ? 2 * std::sqrt(3.0) * (q - p).cross(r - p).norm() / squares : 0.0;
@@ -109,8 +110,8 @@ class BaseFlipper {
     const double fold_after = fold_deg(X, e.a, e.d, e.c, e.d, e.b, e.c);
     if (fold_after > options_.max_fold_deg && fold_after > fold_before) return false;
     if (for_valence) {
-      const double before = std::min(quality(X, e.a, e.b, e.c), quality(X, e.b, e.a, e.d));
-      const double after = std::min(quality(X, e.a, e.d, e.c), quality(X, e.d, e.b, e.c));
+      const double before = std::min(mean_ratio(X, e.a, e.b, e.c), mean_ratio(X, e.b, e.a, e.d));
+      const double after = std::min(mean_ratio(X, e.a, e.d, e.c), mean_ratio(X, e.d, e.b, e.c));
       if (after < options_.valence_quality_share * before) return false;
     }
     relocate(e, quad);

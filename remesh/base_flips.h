@@ -15,8 +15,8 @@ struct BaseFlipOptions {
   /// Degrees: a flip may not fold K more than this between the two new faces, unless it folds
   /// it less than before (a flip across a ridge would cut the shape).
   double max_fold_deg = 40.0;
-  /// A valence flip may not lower the smaller Frey–Borouchaki quality of the two faces below
-  /// this share of what it was.
+  /// A valence flip may not lower the smaller mean-ratio quality (4·sqrt(3)·area / the sum of
+  /// squared edge lengths) of the two faces below this share of what it was.
   double valence_quality_share = 0.9;
 };
 
