@@ -52,7 +52,8 @@ int flip_toward_surface_delaunay(const RowMatrixX3d& X, RowMatrixX3i& F, const F
 int flip_toward_surface_delaunay(const RowMatrixX3d& D, const RowMatrixX3d& X, RowMatrixX3i& F);
 
 /// Flips edges (never boundary edges, never making a duplicate edge, never leaving an interior
-/// vertex with valence < 3 or a boundary vertex with fewer than rim_min_triangles triangles)
+/// vertex with valence < 4, whose triangles' quality would be capped at every level, or a
+/// boundary vertex with fewer than rim_min_triangles triangles)
 /// where `allowed` lets it, while that lowers sum (valence - 6)² (boundary: 3·(valence - 4)²).
 /// \return the number of flips made.
 int flip_toward_regular_valence(int vertices, RowMatrixX3i& F, int rim_min_triangles, const FlipGuard& allowed);

@@ -108,6 +108,23 @@ TEST(BendBound, ALongTubeGrowsTheBaseAndTheTrianglesGetRounder) {
   EXPECT_LT(g["distance"]["hausdorff_pct"].get<double>(), 0.5 * p["distance"]["hausdorff_pct"].get<double>());
 }
 
+TEST(BaseMeshFlips, NoValenceFlipLeavesAnInteriorVertexWithThreeEdges) {
+  // A bipyramid over a 10-gon: the poles have 10 edges, the equator vertices 4. Flipping a
+  // pole's edge to the equator would lower sum (valence - 6)² by 8 (the pole 10 -> 9, two
+  // equator vertices 4 -> 5) but leave the third with three edges, and three triangles at every
+  // level with an angle near 120° each; flipping an equator edge would leave two such vertices.
+  // Nothing is flipped, with every flip allowed.
+  const int m = 10;
+  RowMatrixX3i B(2 * m, 3);
+  for (int i = 0; i < m; ++i) {
+    B.row(i) << m, i, (i + 1) % m;
+    B.row(m + i) << m + 1, (i + 1) % m, i;
+  }
+  const RowMatrixX3i before = B;
+  EXPECT_EQ(flip_toward_regular_valence(m + 2, B, 3, [](const EdgeFlip&) { return true; }), 0);
+  EXPECT_EQ(B, before);
+}
+
 TEST(BaseMeshFlips, AnEdgeFacingTwoObtuseSurfaceAnglesIsFlippedWhereDAllows) {
   // An octahedron in D with ±y tilted toward +x+z, so that the quad around the edge +z/+x is
   // strictly convex. On the surface, ±y sit next to that edge's midpoint: the two angles facing
