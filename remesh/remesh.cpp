@@ -409,6 +409,17 @@ bool on_the_hierarchical_map(const RemeshResult& r) {
   return r.domain == "sphere" && r.parameterization.value("sphere_map", "") == "hierarchical";
 }
 
+// The options with every progress stage named after `prefix`: the second domain's stages
+// repeat the first's names.
+RemeshOptions with_stage_prefix(const RemeshOptions& options, const std::string& prefix) {
+  RemeshOptions prefixed = options;
+  if (options.progress)
+    prefixed.progress = [progress = options.progress, prefix](const std::string& stage, double fraction) {
+      progress(prefix + stage, fraction);
+    };
+  return prefixed;
+}
+
 // Both domains' finest levels compared: fewer self-intersections, then the higher mean
 // quality. If the base mesh fails, for any reason, the sphere's valid result is kept and the
 // failure recorded. The choice's "seconds" are those of the domain not kept and of the
@@ -423,7 +434,7 @@ RemeshResult better_of_both_domains(RemeshResult on_sphere, double sphere_second
   double kept_seconds = 0;  // of the result kept, already in its own seconds
   try {
     const auto base_start = Clock::now();
-    RemeshResult on_base = remesh_on_base_mesh(input, options);
+    RemeshResult on_base = remesh_on_base_mesh(input, with_stage_prefix(options, "base-mesh domain: "));
     const double base_seconds = seconds_since(base_start);
     const FinestLevelScore base_score = finest_level_score(on_base);
     choice["base_mesh"] = score_json(base_score);

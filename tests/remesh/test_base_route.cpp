@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -234,8 +235,16 @@ TEST(BaseDomainRemesh, ADiskRimSlidesAlongTheInputRimToEvenLengths) {
 TEST(AutomaticDomain, AShapeOneChartCannotHoldKeepsTheBetterOfBothDomains) {
   RemeshOptions o;
   o.target_faces = 4096;
+  std::vector<std::string> stages;
+  o.progress = [&](const std::string& stage, double) {
+    if (stages.empty() || stages.back() != stage) stages.push_back(stage);
+  };
   const TriMesh capsule = test::capsule(40.0);
   const RemeshResult r = remesh(capsule, o);
+  // The second domain's stages say which domain they are: no stage name comes twice.
+  const std::set<std::string> distinct(stages.begin(), stages.end());
+  EXPECT_EQ(distinct.size(), stages.size());
+  EXPECT_TRUE(distinct.count("parameterize") && distinct.count("base-mesh domain: parameterize"));
   const nlohmann::json& choice = r.parameterization["domain_choice"];
   ASSERT_TRUE(choice.is_object()) << r.parameterization;
   EXPECT_NE(choice["sphere_map_fallback"].get<std::string>().find("hierarchical"), std::string::npos);
