@@ -1,11 +1,12 @@
 #pragma once
 /// \file surface_moves.h
 /// Small pieces shared by the steps that move the vertices of a level over the input surface in
-/// 3D and carry each move back to the parameter domain D (shape_smoothing.h, triangle_repair.h):
-/// the vertex normal, the no-flip check of a vertex's star in D, the smallest quality of a star,
-/// the point-triangle distance, the equilateral apex of an edge, and the pull-back of a 3D move
-/// through the affine map of one input triangle.
+/// 3D and carry each move back to the parameter domain D (shape_smoothing.h, triangle_repair.h,
+/// base_levels.h): the vertex normal, the no-flip check of a vertex's star in D, the smallest
+/// quality of a star, the point-triangle distance, the equilateral apex of an edge, the repair's
+/// targets, and the pull-back of a 3D move through the affine map of one input triangle.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -91,6 +92,36 @@ inline std::optional<Eigen::Vector3d> equilateral_apex(const Eigen::Vector3d& a,
   const Eigen::Vector3d side = normal.cross(e);
   if (!(side.norm() > 0)) return std::nullopt;
   return Eigen::Vector3d(0.5 * (a + b) + (std::sqrt(3.0) / 2.0) * e.norm() * side.normalized());
+}
+
+/// Where the repair of the worst triangles (triangle_repair.h, base_levels.h) tries to move
+/// vertex v of (X, F) with outward normal `normal`, best guess first: the apex that makes its
+/// worst triangle equilateral, the mean such apex over its triangles, and its ring's centroid.
+/// nullopt where no triangle has an apex (every edge parallel to the normal).
+inline std::optional<std::array<Eigen::Vector3d, 3>> repair_targets(const RowMatrixX3d& X, const RowMatrixX3i& F,
+                                                                    const VertexStars& stars, int v,
+                                                                    const Eigen::Vector3d& normal) {
+  const Eigen::Vector3d x = X.row(v);
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero(), mean_apex = Eigen::Vector3d::Zero(), worst_apex = x;
+  double worst = std::numeric_limits<double>::infinity();
+  int count = 0;
+  for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
+    const int f = stars.faces[i];
+    int k = 0;
+    while (F(f, k) != v) ++k;
+    const Eigen::Vector3d a = X.row(F(f, (k + 1) % 3)), b = X.row(F(f, (k + 2) % 3));
+    const std::optional<Eigen::Vector3d> apex = equilateral_apex(a, b, normal);
+    if (!apex) continue;
+    mean_apex += *apex;
+    centroid += 0.5 * (a + b);  // each neighbour twice around an interior vertex
+    ++count;
+    if (const double q = frey_borouchaki_quality(x, a, b); q < worst) {
+      worst = q;
+      worst_apex = *apex;
+    }
+  }
+  if (count == 0) return std::nullopt;
+  return std::array<Eigen::Vector3d, 3>{worst_apex, mean_apex / count, centroid / count};
 }
 
 /// The affine map of one input triangle from its plane in 3D to D. A 3D move is projected on

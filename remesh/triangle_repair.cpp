@@ -1,6 +1,7 @@
 #include "remesh/triangle_repair.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -100,27 +101,8 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
         if (!(current < options.threshold)) continue;
         const std::optional<Eigen::Vector3d> normal = vertex_normal(X, F, stars, v);
         if (!normal) continue;
-        Eigen::Vector3d centroid = Eigen::Vector3d::Zero(), mean_apex = Eigen::Vector3d::Zero();
-        Eigen::Vector3d worst_apex = x;
-        double worst = std::numeric_limits<double>::infinity();
-        int count = 0;
-        for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
-          const int f = stars.faces[i];
-          int k = 0;
-          while (F(f, k) != v) ++k;
-          const Eigen::Vector3d a = X.row(F(f, (k + 1) % 3)), b = X.row(F(f, (k + 2) % 3));
-          const std::optional<Eigen::Vector3d> apex = equilateral_apex(a, b, *normal);
-          if (!apex) continue;
-          mean_apex += *apex;
-          centroid += 0.5 * (a + b);  // each neighbour twice around an interior vertex
-          ++count;
-          if (const double qf = quality(f, -1, Eigen::Vector3d::Zero()); qf < worst) {
-            worst = qf;
-            worst_apex = *apex;
-          }
-        }
-        if (count == 0) continue;
-        const Eigen::Vector3d targets[3] = {worst_apex, mean_apex / count, centroid / count};
+        const std::optional<std::array<Eigen::Vector3d, 3>> targets = repair_targets(X, F, stars, v, *normal);
+        if (!targets) continue;
         // The affine map of the input triangle under v pulls a 3D move back to D.
         const std::optional<TrianglePullback> pullback = TrianglePullback::of(surface_V, PD, PF, hints[v]);
         if (!pullback) continue;
@@ -130,7 +112,7 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
         double best = current;
         Eigen::Vector3d best_u = u, best_x = x;
         int best_hint = hints[v];
-        for (const Eigen::Vector3d& target : targets) {
+        for (const Eigen::Vector3d& target : *targets) {
           Eigen::Vector3d move = target - x;
           move -= move.dot(*normal) * *normal;
           const Eigen::Vector3d domain_move = pullback->to_domain(move);
