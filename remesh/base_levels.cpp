@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 #include <unordered_map>
@@ -11,6 +12,7 @@
 #include <Eigen/Dense>
 
 #include "mesh/errors.h"
+#include "mesh/quality.h"
 #include "mesh/vertex_stars.h"
 #include "remesh/domain.h"
 #include "remesh/surface_moves.h"
@@ -231,7 +233,126 @@ bool untangle_vertex(const RowMatrixX3i& F, const VertexStars& stars, const Base
   return true;
 }
 
+// How far v's triangles, with v at chart point q of chart c (lifted to x), leave the surface:
+// the largest distance between an edge's 3D midpoint and the lift of its chart midpoint, and
+// from `old` (v before the move, on the surface) to the triangles. Infinite where a midpoint
+// leaves the chart.
+double surface_error_on_base(const RowMatrixX3i& F, const VertexStars& stars, const BaseDomain& domain,
+                             const BaseLift& lift, const BaseLayout& layout, int c, int v, const Eigen::Vector2d& q,
+                             const Eigen::Vector3d& x, const Eigen::Vector3d& old) {
+  double error = 0, to_old = std::numeric_limits<double>::infinity();
+  for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
+    const int f = stars.faces[i];
+    int k = 0;
+    while (F(f, k) != v) ++k;
+    const int a = F(f, (k + 1) % 3), b = F(f, (k + 2) % 3);
+    for (const int w : {a, b}) {
+      const std::optional<BasePoint> mid = domain.from_chart(c, 0.5 * (q + domain.to_chart(c, layout.points[w])));
+      if (!mid) return std::numeric_limits<double>::infinity();
+      error = std::max(error, (lift.lift(*mid) - 0.5 * (x + layout.X.row(w).transpose())).norm());
+    }
+    to_old = std::min(to_old, point_triangle_distance(old, x, layout.X.row(a).transpose(), layout.X.row(b).transpose()));
+  }
+  return std::max(error, to_old);
+}
+
+// Vertex v of a poor triangle to the candidate (repair_targets() at full, half and quarter
+// steps) that raises the smallest Q of its triangles the most, if one does without adding a
+// flip in D and within the guard. Returns whether it moved.
+bool repair_vertex(const RowMatrixX3i& F, const VertexStars& stars, const BaseDomain& domain, const BaseLift& lift,
+                   const BaseRepairOptions& options, double mean_edge, int v, BaseLayout& layout) {
+  const Eigen::Vector3d x = layout.X.row(v);
+  const double current = star_quality(layout.X, F, stars, v, x);
+  const std::optional<Eigen::Vector3d> normal = vertex_normal(layout.X, F, stars, v);
+  if (!(current < options.threshold) || !normal) return false;
+  const std::optional<std::array<Eigen::Vector3d, 3>> targets = repair_targets(layout.X, F, stars, v, *normal);
+  const std::vector<BasePoint> points = star_points(F, stars, layout, v);
+  const int c = domain.common_chart(points.data(), static_cast<int>(points.size()));
+  if (!targets || c < 0) return false;
+  const Eigen::Vector2d start = domain.to_chart(c, layout.points[v]);
+  const int flips = star_flips(domain, F, stars, layout, v, layout.points[v]);
+  double allowed_error = -1;  // the guard's allowance, computed when a candidate first needs it
+  double best = current;
+  std::optional<BasePoint> best_point;
+  Eigen::Vector3d best_x = x;
+  for (const Eigen::Vector3d& target : *targets) {
+    Eigen::Vector3d move = target - x;
+    move -= move.dot(*normal) * *normal;
+    std::optional<Eigen::Vector2d> chart_move = pull_back(domain, lift, c, layout.points[v], move);
+    if (!chart_move) chart_move = pull_back_by_star(domain, F, stars, layout, c, v, *normal, move);
+    if (!chart_move) continue;
+    for (const double t : {1.0, 0.5, 0.25}) {
+      const Eigen::Vector2d q = start + t * *chart_move;
+      const std::optional<BasePoint> p = domain.from_chart(c, q);
+      if (!p || star_flips(domain, F, stars, layout, v, *p) > flips) continue;
+      const Eigen::Vector3d lifted = lift.lift(*p);
+      const double quality = star_quality(layout.X, F, stars, v, lifted);
+      if (!(quality > best + 1e-9)) continue;
+      if (options.error_tolerance >= 0) {
+        if (allowed_error < 0)
+          allowed_error = std::max(surface_error_on_base(F, stars, domain, lift, layout, c, v, start, x, x),
+                                   options.error_tolerance * mean_edge);
+        if (surface_error_on_base(F, stars, domain, lift, layout, c, v, q, lifted, x) > allowed_error) continue;
+      }
+      best = quality;
+      best_point = p;
+      best_x = lifted;
+    }
+  }
+  if (!best_point) return false;
+  layout.points[v] = *best_point;
+  layout.X.row(v) = best_x.transpose();
+  return true;
+}
+
+double smallest_quality(const RowMatrixX3d& X, const RowMatrixX3i& F) {
+  double q = std::numeric_limits<double>::infinity();
+  for (int f = 0; f < F.rows(); ++f)
+    q = std::min(q, frey_borouchaki_quality(X.row(F(f, 0)).transpose(), X.row(F(f, 1)).transpose(),
+                                            X.row(F(f, 2)).transpose()));
+  return F.rows() > 0 ? q : 0.0;
+}
+
+double mean_edge_length(const RowMatrixX3d& X, const RowMatrixX3i& F) {
+  double sum = 0;
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) sum += (X.row(F(f, k)) - X.row(F(f, (k + 1) % 3))).norm();
+  return sum / std::max<Eigen::Index>(1, 3 * F.rows());
+}
+
 }  // namespace
+
+BaseRepairStats repair_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLift& lift,
+                               BaseLayout& layout, const BaseRepairOptions& options) {
+  const int n = static_cast<int>(layout.points.size());
+  const VertexStars stars(F, n);
+  const std::vector<bool> rim = boundary_vertices(F, stars);
+  const double mean_edge = mean_edge_length(layout.X, F);
+  BaseRepairStats stats;
+  stats.q_min_before = smallest_quality(layout.X, F);
+  std::vector<int> visited(n, -1);
+  for (int sweep = 0; sweep < options.sweeps; ++sweep) {
+    std::vector<std::pair<double, int>> poor;
+    for (int f = 0; f < F.rows(); ++f)
+      if (const double q = frey_borouchaki_quality(layout.X.row(F(f, 0)).transpose(), layout.X.row(F(f, 1)).transpose(),
+                                                   layout.X.row(F(f, 2)).transpose());
+          q < options.threshold)
+        poor.emplace_back(q, f);
+    std::sort(poor.begin(), poor.end());
+    int moved = 0;
+    for (const auto& [q, f] : poor)
+      for (int k = 0; k < 3; ++k) {
+        const int v = F(f, k);
+        if (visited[v] == sweep || rim[v]) continue;
+        visited[v] = sweep;
+        if (repair_vertex(F, stars, domain, lift, options, mean_edge, v, layout)) ++moved;
+      }
+    stats.moves += moved;
+    if (moved == 0) break;
+  }
+  stats.q_min_after = smallest_quality(layout.X, F);
+  return stats;
+}
 
 int untangle_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLift& lift, BaseLayout& layout,
                      int sweeps) {

@@ -59,6 +59,35 @@ struct BaseSmoothingOptions {
 int smooth_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLift& lift, BaseLayout& layout,
                    const BaseSmoothingOptions& options);
 
+struct BaseRepairOptions {
+  int sweeps = 6;           ///< passes over the poor triangles (each recomputes which are poor)
+  double threshold = 0.85;  ///< triangles with Q below this are repaired
+  /// If >= 0: refuse moves that take the vertex's triangles further from the surface than
+  /// before, or than this x the mean edge length if that is more (the largest distance between
+  /// an edge's 3D midpoint and the lift of its chart midpoint, and from the vertex's old
+  /// position to its new triangles): better shapes must not cut across ridges or tips.
+  double error_tolerance = -1;
+};
+
+/// What repair_on_base() did.
+struct BaseRepairStats {
+  int moves = 0;
+  double q_min_before = 0;  ///< smallest Q of the level's triangles before the repair
+  double q_min_after = 0;   ///< and after
+};
+
+/// The sphere route's repair of the worst triangles (triangle_repair.h) in the charts of K:
+/// worst first, each interior vertex of a triangle with Q < threshold tries the moves toward
+/// repair_targets() (full, half and quarter steps), pulled back into a chart that holds its
+/// star, and keeps the one that raises the smallest Q of its triangles the most, if any does
+/// without adding a flipped triangle in D (and, with a tolerance, within the surface guard).
+/// Rim vertices stay. Every vertex stays on the input (the lift of its point of D).
+/// \pre layout holds a level of F; no triangle flipped in D.
+/// \post no triangle flipped in D; the smallest Q of every moved vertex's triangles went up,
+///       so the level's smallest Q never goes down.
+BaseRepairStats repair_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLift& lift,
+                               BaseLayout& layout, const BaseRepairOptions& options);
+
 /// Up to `sweeps` sweeps over the interior vertices of flipped triangles, each moved to the
 /// mean of its ring in the chart of its star where that leaves fewer flips around it: charts
 /// disagree a little across K's edges, so a split can fold a sliver that the chart its parent

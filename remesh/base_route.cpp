@@ -165,7 +165,23 @@ LaidOutLevel lay_out_level(const BaseContext& ctx, const RemeshOptions& options,
   return level;
 }
 
-// Level j: laid out (lay_out_level), back onto the original when a simplification was
+// The repair of the finest level's worst triangles (repair_on_base), as the sphere route
+// repairs them, with the surface guard. Coarse levels are not repaired here (whatever
+// options.coarse_levels says): the next level's relaxation starts from them, and repairing them
+// measured worse at the finest level (human at 16k faces: Q mean 0.831 -> 0.810; horse at 16k:
+// Hausdorff distance 0.50 -> 0.94 % of the diagonal). Returns its record (null if it did not run).
+nlohmann::json repair_level_on_base(const BaseContext& ctx, const RepairOptions& options, int j, BaseLayout& layout) {
+  const bool finest = j == ctx.connectivity.levels();
+  if (options.sweeps <= 0 || !finest) return nullptr;
+  BaseRepairOptions repair;
+  repair.sweeps = options.sweeps;
+  repair.threshold = options.threshold;
+  if (options.guard_finest && finest) repair.error_tolerance = options.error_tolerance;
+  const BaseRepairStats s = repair_on_base(ctx.connectivity.faces[j], ctx.domain, ctx.lift, layout, repair);
+  return {{"moves", s.moves}, {"q_min_before", s.q_min_before}, {"q_min_after", s.q_min_after}};
+}
+
+// Level j: laid out (lay_out_level), its worst triangles repaired, back onto the original when a simplification was
 // parameterized, the flip test in D, and the fit of the finest level.
 // \throw AlgorithmError if a triangle is flipped in D.
 RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& options, int j, LevelStart& start,
@@ -175,6 +191,7 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
   const bool full = options.relax == RelaxMode::all_vertices;
   LaidOutLevel laid_out = lay_out_level(ctx, options, j, start);
   BaseLayout& layout = laid_out.layout;
+  const nlohmann::json repair = full ? repair_level_on_base(ctx, options.repair, j, layout) : nlohmann::json();
   RemeshLevel level;
   level.positions = layout.X;
   if (ctx.reproject) reproject_onto(*ctx.reproject, level.positions);
@@ -202,6 +219,7 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
                  {"shape_moves", laid_out.moves},
                  {"started_from", laid_out.from_dyadic ? "dyadic split" : "relaxed split"}};
   if (!fit.is_null()) level.stats["fit"] = fit;
+  if (!repair.is_null()) level.stats["repair"] = repair;
   if (options.compute_stats && ctx.locator) measure_level(ctx.original, *ctx.locator, F, level);
   return level;
 }

@@ -105,6 +105,7 @@ struct RepairOptions {
   int sweeps = 6;
   double threshold = 0.85;
   /// Repair every level (true) or only the finest (false: coarse levels keep the Lloyd layout).
+  /// The base-mesh domain repairs its finest level only, either way.
   bool coarse_levels = true;
   /// On the finest level, which is what is measured against the input, refuse moves that take
   /// triangles further from the surface (TriangleRepairOptions::guard_surface_error).

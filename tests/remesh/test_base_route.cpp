@@ -17,6 +17,7 @@
 #include "mesh/topology.h"
 #include "remesh/base_levels.h"
 #include "remesh/domain.h"
+#include "remesh/maps.h"
 #include "remesh/remesh.h"
 #include "remesh/remesh_options_json.h"
 #include "tests/remesh/remesh_shapes.h"
@@ -150,6 +151,49 @@ TEST(BaseLevels, SplitPlacesMidpointsAndReportsAnEdgeWithNoChart) {
   BaseLayout moved = start;
   moved.points[p[0]] = BasePoint{far_face, Eigen::Vector3d::Constant(1.0 / 3)};
   EXPECT_FALSE(split_on_base(c, 1, domain, lift, moved));
+}
+
+double smallest_q(const RowMatrixX3d& X, const RowMatrixX3i& F) {
+  double q = 1;
+  for (int f = 0; f < F.rows(); ++f)
+    q = std::min(q, frey_borouchaki_quality(X.row(F(f, 0)).transpose(), X.row(F(f, 1)).transpose(),
+                                            X.row(F(f, 2)).transpose()));
+  return q;
+}
+
+// The MAPS remesh of a capsule (the dyadic split of K, unrelaxed) has poor triangles where K's
+// faces are; the repair raises the worst of them, adds no flip in D, and leaves every vertex
+// exactly on the input (the lift of its point of D), with and without the surface guard.
+TEST(BaseLevels, RepairRaisesTheWorstQualityOnTheInputWithoutAFlip) {
+  const TriMesh input = test::capsule(6.0, 24);
+  MapsOptions maps_options;
+  maps_options.base_vertices = 40;
+  const MapsParameterization maps = maps_parameterize(input, maps_options);
+  const BaseDomain domain(maps.base);
+  const BaseLift lift(input, domain, maps.location);
+  const SubdivisionConnectivity c = subdivide_connectivity(maps.base.F, maps.base.num_vertices(), 2);
+  BaseLayout dyadic = base_vertices_layout(domain, lift);
+  for (int j = 1; j <= 2; ++j) ASSERT_TRUE(split_on_base(c, j, domain, lift, dyadic));
+  const RowMatrixX3i& F = c.faces[2];
+  ASSERT_EQ(count_flipped_on_base(domain, F, dyadic.points), 0);
+  const double before = smallest_q(dyadic.X, F);
+  ASSERT_LT(before, 0.5);
+  for (const double tolerance : {-1.0, 0.03}) {
+    SCOPED_TRACE("error tolerance " + std::to_string(tolerance));
+    BaseLayout layout = dyadic;
+    BaseRepairOptions options;
+    options.error_tolerance = tolerance;
+    const BaseRepairStats stats = repair_on_base(F, domain, lift, layout, options);
+    EXPECT_GT(stats.moves, 0);
+    EXPECT_DOUBLE_EQ(stats.q_min_before, before);
+    EXPECT_DOUBLE_EQ(stats.q_min_after, smallest_q(layout.X, F));
+    EXPECT_GT(stats.q_min_after, before + 0.05) << stats.q_min_after;
+    EXPECT_EQ(count_flipped_on_base(domain, F, layout.points), 0);
+    double off = 0;
+    for (std::size_t v = 0; v < layout.points.size(); ++v)
+      off = std::max(off, (layout.X.row(v).transpose() - lift.lift(layout.points[v])).norm());
+    EXPECT_EQ(off, 0.0);
+  }
 }
 
 // The octopus's tentacles stretch relaxed slivers across more than one chart of K, or fold
