@@ -284,10 +284,10 @@ bool repair_vertex(const RowMatrixX3i& F, const VertexStars& stars, const BaseDo
     for (const double t : {1.0, 0.5, 0.25}) {
       const Eigen::Vector2d q = start + t * *chart_move;
       const std::optional<BasePoint> p = domain.from_chart(c, q);
-      if (!p || star_flips(domain, F, stars, layout, v, *p) > flips) continue;
+      if (!p) continue;
       const Eigen::Vector3d lifted = lift.lift(*p);
       const double quality = star_quality(layout.X, F, stars, v, lifted);
-      if (!(quality > best + 1e-9)) continue;
+      if (!(quality > best + 1e-9) || star_flips(domain, F, stars, layout, v, *p) > flips) continue;
       if (options.error_tolerance >= 0) {
         if (allowed_error < 0)
           allowed_error = std::max(surface_error_on_base(F, stars, domain, lift, layout, c, v, start, x, x),
@@ -331,6 +331,7 @@ BaseRepairStats repair_on_base(const RowMatrixX3i& F, const BaseDomain& domain, 
   BaseRepairStats stats;
   stats.q_min_before = smallest_quality(layout.X, F);
   std::vector<int> visited(n, -1);
+  RepairRetries retries(F, stars, n);
   for (int sweep = 0; sweep < options.sweeps; ++sweep) {
     std::vector<std::pair<double, int>> poor;
     for (int f = 0; f < F.rows(); ++f)
@@ -343,15 +344,35 @@ BaseRepairStats repair_on_base(const RowMatrixX3i& F, const BaseDomain& domain, 
     for (const auto& [q, f] : poor)
       for (int k = 0; k < 3; ++k) {
         const int v = F(f, k);
-        if (visited[v] == sweep || rim[v]) continue;
+        if (visited[v] == sweep || rim[v] || (options.fixed && (*options.fixed)[v])) continue;
         visited[v] = sweep;
-        if (repair_vertex(F, stars, domain, lift, options, mean_edge, v, layout)) ++moved;
+        if (!retries.worth_trying(v)) continue;
+        if (repair_vertex(F, stars, domain, lift, options, mean_edge, v, layout)) {
+          retries.moved(v);
+          ++moved;
+        } else {
+          retries.failed(v);
+        }
       }
     stats.moves += moved;
     if (moved == 0) break;
   }
   stats.q_min_after = smallest_quality(layout.X, F);
   return stats;
+}
+
+int snap_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLift& lift, BaseLayout& layout,
+                 const FeatureSnapOptions& options, std::vector<bool>* snapped) {
+  const VertexStars stars(F, static_cast<int>(layout.points.size()));
+  const std::vector<BasePoint> before = layout.points;
+  const SnapInDomain moves{
+      [&](int v, int s) { return star_flips(domain, F, stars, layout, v, lift.location(s)) == 0; },
+      [&](int v, int s) { layout.points[v] = lift.location(s); }, [&] { layout.points = before; }};
+  const RowMatrixX3d& input_V = lift.input_vertices();
+  const RowMatrixX3i& input_F = lift.input_faces();
+  return snap_level_to_input_tips(F, layout.X, input_V, input_F, boundary_vertices(F, stars),
+                                  boundary_vertices(input_F, static_cast<int>(input_V.rows())), moves, options,
+                                  snapped);
 }
 
 int untangle_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLift& lift, BaseLayout& layout,

@@ -15,6 +15,7 @@
 #include "mesh/trimesh.h"
 #include "remesh/base_domain.h"
 #include "remesh/base_lift.h"
+#include "remesh/feature_snap.h"
 #include "remesh/shape_smoothing.h"
 
 namespace mrsnake {
@@ -59,6 +60,16 @@ struct BaseSmoothingOptions {
 int smooth_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLift& lift, BaseLayout& layout,
                    const BaseSmoothingOptions& options);
 
+/// The sphere route's snap of the finest level onto the input's tips (feature_snap.h) in the
+/// base domain: a vertex moves to an input vertex's own point of D where no triangle of its
+/// star is flipped there. Rim vertices stay; input rim vertices are no tips.
+/// \pre layout holds a level of F; no triangle flipped in D.
+/// \post as snap_level_to_input_tips(): each moved vertex is exactly its input vertex (X) at that
+///       vertex's point of D; no triangle flipped in D; `snapped`, if given, marks the moved.
+/// \return the number of vertices moved.
+int snap_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLift& lift, BaseLayout& layout,
+                 const FeatureSnapOptions& options, std::vector<bool>* snapped = nullptr);
+
 struct BaseRepairOptions {
   int sweeps = 6;           ///< passes over the poor triangles (each recomputes which are poor)
   double threshold = 0.85;  ///< triangles with Q below this are repaired
@@ -67,6 +78,9 @@ struct BaseRepairOptions {
   /// an edge's 3D midpoint and the lift of its chart midpoint, and from the vertex's old
   /// position to its new triangles): better shapes must not cut across ridges or tips.
   double error_tolerance = -1;
+  /// If set (one entry per vertex), vertices marked true never move: the tips snap_on_base put
+  /// exactly on the input.
+  const std::vector<bool>* fixed = nullptr;
 };
 
 /// What repair_on_base() did.

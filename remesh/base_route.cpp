@@ -170,10 +170,12 @@ LaidOutLevel lay_out_level(const BaseContext& ctx, const RemeshOptions& options,
 // options.coarse_levels says): the next level's relaxation starts from them, and repairing them
 // measured worse at the finest level (human at 16k faces: Q mean 0.831 -> 0.810; horse at 16k:
 // Hausdorff distance 0.50 -> 0.94 % of the diagonal). Returns its record (null if it did not run).
-nlohmann::json repair_level_on_base(const BaseContext& ctx, const RepairOptions& options, int j, BaseLayout& layout) {
+nlohmann::json repair_level_on_base(const BaseContext& ctx, const RepairOptions& options, int j,
+                                    const std::vector<bool>& snapped, BaseLayout& layout) {
   const bool finest = j == ctx.connectivity.levels();
   if (options.sweeps <= 0 || !finest) return nullptr;
   BaseRepairOptions repair;
+  repair.fixed = &snapped;
   repair.sweeps = options.sweeps;
   repair.threshold = options.threshold;
   if (options.guard_finest && finest) repair.error_tolerance = options.error_tolerance;
@@ -191,7 +193,12 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
   const bool full = options.relax == RelaxMode::all_vertices;
   LaidOutLevel laid_out = lay_out_level(ctx, options, j, start);
   BaseLayout& layout = laid_out.layout;
-  const nlohmann::json repair = full ? repair_level_on_base(ctx, options.repair, j, layout) : nlohmann::json();
+  // The finest level's tips first, then its worst triangles around them (the snapped stay).
+  std::vector<bool> snapped(layout.points.size(), false);
+  const int snaps = full && options.snap.max_snaps > 0 && j == ctx.connectivity.levels()
+                        ? snap_on_base(F, ctx.domain, ctx.lift, layout, options.snap, &snapped)
+                        : 0;
+  const nlohmann::json repair = full ? repair_level_on_base(ctx, options.repair, j, snapped, layout) : nlohmann::json();
   RemeshLevel level;
   level.positions = layout.X;
   if (ctx.reproject) reproject_onto(*ctx.reproject, level.positions);
@@ -201,8 +208,9 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
                          " flipped triangles in the base domain; the surface cannot be remeshed well");
   nlohmann::json fit;
   if (full && options.fit.rounds > 0 && j == ctx.connectivity.levels() && ctx.locator) {
-    const SurfaceFitStats s = fit_to_surface(F, level.positions, *ctx.locator, options.fit,
-                                             boundary_vertices(F, static_cast<int>(level.positions.rows())));
+    std::vector<bool> fixed = boundary_vertices(F, static_cast<int>(level.positions.rows()));
+    for (std::size_t v = 0; v < fixed.size(); ++v) fixed[v] = fixed[v] || snapped[v];  // the tips stay on the input
+    const SurfaceFitStats s = fit_to_surface(F, level.positions, *ctx.locator, options.fit, fixed);
     fit = {{"rms_before_mm", s.rms_before}, {"rms_after_mm", s.rms_after}, {"max_offset_mm", s.max_offset}};
   }
   level.domain_positions.resize(layout.points.size(), 3);
@@ -220,6 +228,7 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
                  {"started_from", laid_out.from_dyadic ? "dyadic split" : "relaxed split"}};
   if (!fit.is_null()) level.stats["fit"] = fit;
   if (!repair.is_null()) level.stats["repair"] = repair;
+  if (j == ctx.connectivity.levels()) level.stats["snapped_vertices"] = snaps;
   if (options.compute_stats && ctx.locator) measure_level(ctx.original, *ctx.locator, F, level);
   return level;
 }

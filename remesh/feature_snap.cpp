@@ -11,23 +11,19 @@
 
 namespace mrsnake {
 
-int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh& param, const RowMatrixX3d& surface_V,
-                       RowMatrixX3d& U, RowMatrixX3d& X, std::vector<int>& hints, const FeatureSnapOptions& options,
-                       std::vector<bool>* snapped) {
-  const int n = static_cast<int>(U.rows());
+int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMatrixX3d& surface_V,
+                             const RowMatrixX3i& input_F, const std::vector<bool>& rim,
+                             const std::vector<bool>& input_rim, const SnapInDomain& domain,
+                             const FeatureSnapOptions& options, std::vector<bool>* snapped) {
+  const int n = static_cast<int>(X.rows());
   const int m = static_cast<int>(F.rows());
   if (snapped) snapped->assign(n, false);
   if (m == 0 || options.max_snaps <= 0) return 0;
   const VertexStars stars(F, n);
-  const std::vector<bool> rim = kind == DomainKind::disk ? boundary_vertices(F, stars) : std::vector<bool>(n, false);
-  const auto& PF = param.faces();
-  const auto& PD = param.positions();
-  const int input_vertices = static_cast<int>(PD.rows());
-  const std::vector<bool> input_rim =
-      kind == DomainKind::disk ? boundary_vertices(PF, input_vertices) : std::vector<bool>(input_vertices, false);
+  const int input_vertices = static_cast<int>(surface_V.rows());
   std::vector<int> face_of(input_vertices, -1);  // one face of the input around each of its vertices
-  for (int f = 0; f < PF.rows(); ++f)
-    for (int k = 0; k < 3; ++k) face_of[PF(f, k)] = f;
+  for (int f = 0; f < input_F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) face_of[input_F(f, k)] = f;
   double mean_edge = 0;
   for (int f = 0; f < m; ++f)
     for (int k = 0; k < 3; ++k) mean_edge += (X.row(F(f, k)) - X.row(F(f, (k + 1) % 3))).norm();
@@ -116,8 +112,7 @@ int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh&
     return smallest;
   };
   std::vector<bool> moved(n, false);
-  const RowMatrixX3d U_before = U, X_before = X;
-  const std::vector<int> hints_before = hints;
+  const RowMatrixX3d X_before = X;
   int snaps = 0, judged = 0;
   const int max_judged = 8 * options.max_snaps;  // the region error is the costly part
   for (int s : far) {
@@ -140,17 +135,15 @@ int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh&
     collect_region(v);
     // An earlier snap nearby may have fixed this tip already: its distance now, not before.
     if (!(region_distance(x, v, x_old) > threshold)) continue;
-    const Eigen::Vector3d u = project_to_domain(kind, PD.row(s).transpose(), false);
-    if (!star_unflipped_in_domain(U, F, stars, v, u)) continue;
+    if (!domain.allowed(v, s)) continue;
     if (star_quality(X, F, stars, v, x) < options.min_quality || star_angle(v, x) < options.min_angle_deg) continue;
     // Worth it only if the input around v ends up really closer to the level: moving v onto s
     // also moves its triangles away from the input v stood on.
     ++judged;
     const double before = region_error(v, x_old), after = region_error(v, x);
     if (!(after <= (1 - options.min_gain) * before)) continue;
-    U.row(v) = u.transpose();
+    domain.apply(v, s);
     X.row(v) = x.transpose();
-    hints[v] = face_of[s];
     moved[v] = true;
     ++snaps;
   }
@@ -175,14 +168,44 @@ int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh&
       points.row(static_cast<Eigen::Index>(i)) = surface_V.row(recheck[i]);
     const double largest_after = recheck.empty() ? 0.0 : SurfaceLocator(TriMesh{X, F}).distances(points).maxCoeff();
     if (!(largest_after <= limit)) {
-      U = U_before;
       X = X_before;
-      hints = hints_before;
+      domain.undo();
+      if (snapped) snapped->assign(n, false);
       return 0;
     }
   }
   if (snapped) *snapped = moved;
   return snaps;
+}
+
+int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh& param, const RowMatrixX3d& surface_V,
+                       RowMatrixX3d& U, RowMatrixX3d& X, std::vector<int>& hints, const FeatureSnapOptions& options,
+                       std::vector<bool>* snapped) {
+  const int n = static_cast<int>(U.rows());
+  const VertexStars stars(F, n);
+  const auto& PF = param.faces();
+  const auto& PD = param.positions();
+  const bool disk = kind == DomainKind::disk;
+  std::vector<int> face_of(PD.rows(), -1);
+  for (int f = 0; f < PF.rows(); ++f)
+    for (int k = 0; k < 3; ++k) face_of[PF(f, k)] = f;
+  const RowMatrixX3d U_before = U;
+  const std::vector<int> hints_before = hints;
+  const auto point_of = [&](int s) { return project_to_domain(kind, PD.row(s).transpose(), false); };
+  const SnapInDomain domain{
+      [&](int v, int s) { return star_unflipped_in_domain(U, F, stars, v, point_of(s)); },
+      [&](int v, int s) {
+        U.row(v) = point_of(s).transpose();
+        hints[v] = face_of[s];
+      },
+      [&] {
+        U = U_before;
+        hints = hints_before;
+      }};
+  return snap_level_to_input_tips(F, X, surface_V, PF, disk ? boundary_vertices(F, stars) : std::vector<bool>(n, false),
+                                  disk ? boundary_vertices(PF, static_cast<int>(PD.rows()))
+                                       : std::vector<bool>(PD.rows(), false),
+                                  domain, options, snapped);
 }
 
 }  // namespace mrsnake

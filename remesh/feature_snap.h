@@ -11,6 +11,7 @@
 /// when its turn comes, after the snaps before it. Snaps cost triangle quality, so only tips
 /// that set the Hausdorff distance are tried, and all snaps are undone unless together they
 /// lower the largest input-to-level distance.
+#include <functional>
 #include <vector>
 
 #include "mesh/trimesh.h"
@@ -31,6 +32,24 @@ struct FeatureSnapOptions {
   /// that make the Hausdorff distance (a snap costs triangle quality).
   double min_share_of_largest = 0.5;
 };
+
+/// What the snap asks of the parameter domain, which holds a point of D per level vertex.
+struct SnapInDomain {
+  std::function<bool(int v, int s)> allowed;  ///< v at input vertex s's point of D flips none of its triangles there
+  std::function<void(int v, int s)> apply;    ///< puts v at s's point of D
+  std::function<void()> undo;                 ///< puts every vertex back where it was before the snap
+};
+
+/// The snap in any parameter domain: level (X, F), input vertices surface_V with faces input_F;
+/// level vertices on `rim` stay, input vertices on `input_rim` are no tips.
+/// \pre as snap_to_input_tips(), in `domain`; rim has one entry per row of X, input_rim one per
+///      row of surface_V.
+/// \post as snap_to_input_tips(): every moved vertex is exactly its input vertex in X and at
+///       its point of D; if the snaps are not kept, X and the domain are as they were.
+int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMatrixX3d& surface_V,
+                             const RowMatrixX3i& input_F, const std::vector<bool>& rim,
+                             const std::vector<bool>& input_rim, const SnapInDomain& domain,
+                             const FeatureSnapOptions& options, std::vector<bool>* snapped = nullptr);
 
 /// Snaps vertices of (U, F) (lifted X) onto the input vertices farthest from (X, F).
 /// \pre X = lift of U onto the surface whose domain mesh is `param` (3D positions surface_V);

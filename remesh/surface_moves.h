@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -123,6 +124,35 @@ inline std::optional<std::array<Eigen::Vector3d, 3>> repair_targets(const RowMat
   if (count == 0) return std::nullopt;
   return std::array<Eigen::Vector3d, 3>{worst_apex, mean_apex / count, centroid / count};
 }
+
+/// Which vertices a repair sweep need not try again. A vertex's attempt depends only on the
+/// positions of its star, so after a failed attempt it is tried again only once something in
+/// its 1-ring has moved: the same result, fewer attempts.
+class RepairRetries {
+ public:
+  RepairRetries(const RowMatrixX3i& F, const VertexStars& stars, int n)
+      : F_(F), stars_(stars), moved_at_(n, -1), failed_at_(n, -1) {}
+
+  /// Never tried, or something in its 1-ring moved since it last failed.
+  bool worth_trying(int v) const {
+    if (failed_at_[v] < 0) return true;
+    for (int i = stars_.offset[v]; i < stars_.offset[v + 1]; ++i)
+      for (int k = 0; k < 3; ++k)
+        if (moved_at_[F_(stars_.faces[i], k)] > failed_at_[v]) return true;
+    return false;
+  }
+  void failed(int v) { failed_at_[v] = ++clock_; }
+  void moved(int v) {
+    failed_at_[v] = -1;
+    moved_at_[v] = ++clock_;
+  }
+
+ private:
+  const RowMatrixX3i& F_;
+  const VertexStars& stars_;
+  long clock_ = 0;
+  std::vector<long> moved_at_, failed_at_;
+};
 
 /// The affine map of one input triangle from its plane in 3D to D. A 3D move is projected on
 /// the triangle's plane (least squares) and mapped to the move in D that gives it, to first

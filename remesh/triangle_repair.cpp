@@ -70,17 +70,7 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
   stats.q_min_before = smallest_q();
   std::vector<std::pair<double, int>> poor;
   std::vector<int> visited(n, -1);
-  // A vertex's attempt depends only on its 1-ring's positions: after a failed attempt it is
-  // tried again only once something in its 1-ring has moved (same result, fewer attempts).
-  long clock = 0;
-  std::vector<long> moved_at(n, -1), failed_at(n, -1);
-  const auto ring_moved_since = [&](int v, long time) {
-    if (moved_at[v] > time) return true;
-    for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i)
-      for (int k = 0; k < 3; ++k)
-        if (moved_at[F(stars.faces[i], k)] > time) return true;
-    return false;
-  };
+  RepairRetries retries(F, stars, n);
   for (int sweep = 0; sweep < options.sweeps; ++sweep) {
     poor.clear();
     for (int f = 0; f < m; ++f)
@@ -94,8 +84,8 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
         if (visited[v] == sweep || (boundary[v] && !options.move_rim)) continue;
         if (options.fixed && (*options.fixed)[v]) continue;
         visited[v] = sweep;
-        if (failed_at[v] >= 0 && !ring_moved_since(v, failed_at[v])) continue;
-        failed_at[v] = ++clock;  // cleared below if v moves
+        if (!retries.worth_trying(v)) continue;
+        retries.failed(v);  // undone below if v moves
         const Eigen::Vector3d x = X.row(v);
         const double current = star_quality(X, F, stars, v, x);
         if (!(current < options.threshold)) continue;
@@ -138,8 +128,7 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
         U.row(v) = best_u.transpose();
         X.row(v) = best_x.transpose();
         hints[v] = best_hint;
-        failed_at[v] = -1;
-        moved_at[v] = ++clock;
+        retries.moved(v);
         ++moved;
       }
     stats.moves += moved;

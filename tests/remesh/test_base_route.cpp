@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <set>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -193,6 +194,87 @@ TEST(BaseLevels, RepairRaisesTheWorstQualityOnTheInputWithoutAFlip) {
     for (std::size_t v = 0; v < layout.points.size(); ++v)
       off = std::max(off, (layout.X.row(v).transpose() - lift.lift(layout.points[v])).norm());
     EXPECT_EQ(off, 0.0);
+  }
+}
+
+// An ellipsoid with a spike at one end of its long axis.
+TriMesh spiked_ellipsoid() {
+  TriMesh m = test::ellipsoid(4);
+  Eigen::Index tip = 0;
+  m.V.col(0).maxCoeff(&tip);
+  m.V.row(tip) *= 1.15;
+  return m;
+}
+
+// That ellipsoid's MAPS remesh split twice and relaxed in the base domain: the relaxation pulls
+// the vertices off the spike, and the level cuts it off.
+struct RelaxedEllipsoidLevel {
+  TriMesh input = spiked_ellipsoid();
+  MapsParameterization maps;
+  BaseDomain domain;
+  BaseLift lift;
+  SubdivisionConnectivity c;
+  BaseLayout layout;
+
+  static MapsParameterization simplified(const TriMesh& input) {
+    MapsOptions options;
+    options.base_vertices = 30;
+    return maps_parameterize(input, options);
+  }
+  RelaxedEllipsoidLevel()
+      : maps(simplified(input)),
+        domain(maps.base),
+        lift(input, domain, maps.location),
+        c(subdivide_connectivity(maps.base.F, maps.base.num_vertices(), 2)),
+        layout(base_vertices_layout(domain, lift)) {
+    for (int j = 1; j <= 2; ++j) {
+      if (!split_on_base(c, j, domain, lift, layout)) throw std::logic_error("split");
+      smooth_on_base(c.faces[j], domain, lift, layout, BaseSmoothingOptions{});
+    }
+  }
+};
+
+// The snap in the base domain: vertices move exactly onto input vertices at their own points
+// of D, the largest input-to-level distance goes down, and nothing flips. A gain no snap can
+// give refuses them all and leaves the layout as it was.
+TEST(BaseLevels, SnapPutsVerticesExactlyOnTheTipsTheLevelCutsOff) {
+  RelaxedEllipsoidLevel level;
+  const RowMatrixX3i& F = level.c.faces[2];
+  BaseLayout& layout = level.layout;
+  const BaseLayout before = layout;
+  const double cut = SurfaceLocator(TriMesh{layout.X, F}).distances(level.input.V).maxCoeff();
+  std::vector<bool> snapped;
+  FeatureSnapOptions options;  // a tip this sharp would leave triangles below the default bounds
+  options.min_quality = 0.2;
+  options.min_angle_deg = 10;
+  const int snaps = snap_on_base(F, level.domain, level.lift, layout, options, &snapped);
+  EXPECT_GT(snaps, 0);
+  EXPECT_LT(SurfaceLocator(TriMesh{layout.X, F}).distances(level.input.V).maxCoeff(), 0.75 * cut);
+  EXPECT_EQ(count_flipped_on_base(level.domain, F, layout.points), 0);
+  int moved = 0;
+  for (std::size_t v = 0; v < layout.points.size(); ++v) {
+    if (!snapped[v]) {
+      EXPECT_TRUE(layout.X.row(v) == before.X.row(v));
+      continue;
+    }
+    ++moved;
+    int at = -1;
+    for (int s = 0; s < level.input.num_vertices(); ++s)
+      if (level.input.V.row(s) == layout.X.row(v)) at = s;
+    ASSERT_GE(at, 0) << "vertex " << v << " is no input vertex";
+    EXPECT_EQ(layout.points[v].face, level.maps.location[at].face);
+    EXPECT_TRUE(layout.points[v].bary == level.maps.location[at].bary);
+  }
+  EXPECT_EQ(moved, snaps);
+
+  RelaxedEllipsoidLevel again;
+  FeatureSnapOptions all_or_nothing = options;
+  all_or_nothing.min_gain = 1.0;
+  EXPECT_EQ(snap_on_base(F, again.domain, again.lift, again.layout, all_or_nothing, &snapped), 0);
+  EXPECT_TRUE(again.layout.X == before.X);
+  for (std::size_t v = 0; v < before.points.size(); ++v) {
+    EXPECT_EQ(again.layout.points[v].face, before.points[v].face);
+    EXPECT_TRUE(again.layout.points[v].bary == before.points[v].bary);
   }
 }
 
