@@ -178,13 +178,14 @@ nlohmann::json repair_level_on_base(const BaseContext& ctx, const RepairOptions&
   repair.fixed = &snapped;
   repair.sweeps = options.sweeps;
   repair.threshold = options.threshold;
-  if (options.guard_finest && finest) repair.error_tolerance = options.error_tolerance;
+  if (options.guard_finest) repair.error_tolerance = options.error_tolerance;
   const BaseRepairStats s = repair_on_base(ctx.connectivity.faces[j], ctx.domain, ctx.lift, layout, repair);
   return {{"moves", s.moves}, {"q_min_before", s.q_min_before}, {"q_min_after", s.q_min_after}};
 }
 
-// Level j: laid out (lay_out_level), its worst triangles repaired, back onto the original when a simplification was
-// parameterized, the flip test in D, and the fit of the finest level.
+// Level j: laid out (lay_out_level); on the finest level its tips snapped and its worst
+// triangles repaired; back onto the original when a simplification was parameterized; the
+// flip test in D; and the fit of the finest level.
 // \throw AlgorithmError if a triangle is flipped in D.
 RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& options, int j, LevelStart& start,
                              double extra_seconds) {

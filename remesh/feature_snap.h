@@ -46,6 +46,7 @@ struct SnapInDomain {
 ///      row of surface_V.
 /// \post as snap_to_input_tips(): every moved vertex is exactly its input vertex in X and at
 ///       its point of D; if the snaps are not kept, X and the domain are as they were.
+/// \throw nothing beyond std::bad_alloc and what `domain`'s functions throw.
 int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMatrixX3d& surface_V,
                              const RowMatrixX3i& input_F, const std::vector<bool>& rim,
                              const std::vector<bool>& input_rim, const SnapInDomain& domain,
