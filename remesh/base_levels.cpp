@@ -251,7 +251,8 @@ double surface_error_on_base(const RowMatrixX3i& F, const VertexStars& stars, co
       if (!mid) return std::numeric_limits<double>::infinity();
       error = std::max(error, (lift.lift(*mid) - 0.5 * (x + layout.X.row(w).transpose())).norm());
     }
-    to_old = std::min(to_old, point_triangle_distance(old, x, layout.X.row(a).transpose(), layout.X.row(b).transpose()));
+    to_old =
+        std::min(to_old, point_triangle_distance(old, x, layout.X.row(a).transpose(), layout.X.row(b).transpose()));
   }
   return std::max(error, to_old);
 }
@@ -308,8 +309,8 @@ bool repair_vertex(const RowMatrixX3i& F, const VertexStars& stars, const BaseDo
 double smallest_quality(const RowMatrixX3d& X, const RowMatrixX3i& F) {
   double q = std::numeric_limits<double>::infinity();
   for (int f = 0; f < F.rows(); ++f)
-    q = std::min(q, frey_borouchaki_quality(X.row(F(f, 0)).transpose(), X.row(F(f, 1)).transpose(),
-                                            X.row(F(f, 2)).transpose()));
+    q = std::min(
+        q, frey_borouchaki_quality(X.row(F(f, 0)).transpose(), X.row(F(f, 1)).transpose(), X.row(F(f, 2)).transpose()));
   return F.rows() > 0 ? q : 0.0;
 }
 
@@ -365,9 +366,8 @@ int snap_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLift
                  const FeatureSnapOptions& options, std::vector<bool>* snapped) {
   const VertexStars stars(F, static_cast<int>(layout.points.size()));
   const std::vector<BasePoint> before = layout.points;
-  const SnapInDomain moves{
-      [&](int v, int s) { return star_flips(domain, F, stars, layout, v, lift.location(s)) == 0; },
-      [&](int v, int s) { layout.points[v] = lift.location(s); }, [&] { layout.points = before; }};
+  const SnapInDomain moves{[&](int v, int s) { return star_flips(domain, F, stars, layout, v, lift.location(s)) == 0; },
+                           [&](int v, int s) { layout.points[v] = lift.location(s); }, [&] { layout.points = before; }};
   const RowMatrixX3d& input_V = lift.input_vertices();
   const RowMatrixX3i& input_F = lift.input_faces();
   return snap_level_to_input_tips(F, layout.X, input_V, input_F, boundary_vertices(F, stars),

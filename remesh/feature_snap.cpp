@@ -192,20 +192,19 @@ int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh&
   const RowMatrixX3d U_before = U;
   const std::vector<int> hints_before = hints;
   const auto point_of = [&](int s) { return project_to_domain(kind, PD.row(s).transpose(), false); };
-  const SnapInDomain domain{
-      [&](int v, int s) { return star_unflipped_in_domain(U, F, stars, v, point_of(s)); },
-      [&](int v, int s) {
-        U.row(v) = point_of(s).transpose();
-        hints[v] = face_of[s];
-      },
-      [&] {
-        U = U_before;
-        hints = hints_before;
-      }};
-  return snap_level_to_input_tips(F, X, surface_V, PF, disk ? boundary_vertices(F, stars) : std::vector<bool>(n, false),
-                                  disk ? boundary_vertices(PF, static_cast<int>(PD.rows()))
-                                       : std::vector<bool>(PD.rows(), false),
-                                  domain, options, snapped);
+  const SnapInDomain domain{[&](int v, int s) { return star_unflipped_in_domain(U, F, stars, v, point_of(s)); },
+                            [&](int v, int s) {
+                              U.row(v) = point_of(s).transpose();
+                              hints[v] = face_of[s];
+                            },
+                            [&] {
+                              U = U_before;
+                              hints = hints_before;
+                            }};
+  return snap_level_to_input_tips(
+      F, X, surface_V, PF, disk ? boundary_vertices(F, stars) : std::vector<bool>(n, false),
+      disk ? boundary_vertices(PF, static_cast<int>(PD.rows())) : std::vector<bool>(PD.rows(), false), domain, options,
+      snapped);
 }
 
 }  // namespace mrsnake

@@ -157,8 +157,8 @@ TEST(BaseLevels, SplitPlacesMidpointsAndReportsAnEdgeWithNoChart) {
 double smallest_q(const RowMatrixX3d& X, const RowMatrixX3i& F) {
   double q = 1;
   for (int f = 0; f < F.rows(); ++f)
-    q = std::min(q, frey_borouchaki_quality(X.row(F(f, 0)).transpose(), X.row(F(f, 1)).transpose(),
-                                            X.row(F(f, 2)).transpose()));
+    q = std::min(
+        q, frey_borouchaki_quality(X.row(F(f, 0)).transpose(), X.row(F(f, 1)).transpose(), X.row(F(f, 2)).transpose()));
   return q;
 }
 
