@@ -233,28 +233,16 @@ bool untangle_vertex(const RowMatrixX3i& F, const VertexStars& stars, const Base
   return true;
 }
 
-// How far v's triangles, with v at chart point q of chart c (lifted to x), leave the surface:
-// the largest distance between an edge's 3D midpoint and the lift of its chart midpoint, and
-// from `old` (v before the move, on the surface) to the triangles. Infinite where a midpoint
-// leaves the chart.
+// How far v's triangles, with v at chart point q of chart c (lifted to x), leave the surface
+// (star_surface_error), the midpoints taken in chart c.
 double surface_error_on_base(const RowMatrixX3i& F, const VertexStars& stars, const BaseDomain& domain,
                              const BaseLift& lift, const BaseLayout& layout, int c, int v, const Eigen::Vector2d& q,
                              const Eigen::Vector3d& x, const Eigen::Vector3d& old) {
-  double error = 0, to_old = std::numeric_limits<double>::infinity();
-  for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
-    const int f = stars.faces[i];
-    int k = 0;
-    while (F(f, k) != v) ++k;
-    const int a = F(f, (k + 1) % 3), b = F(f, (k + 2) % 3);
-    for (const int w : {a, b}) {
-      const std::optional<BasePoint> mid = domain.from_chart(c, 0.5 * (q + domain.to_chart(c, layout.points[w])));
-      if (!mid) return std::numeric_limits<double>::infinity();
-      error = std::max(error, (lift.lift(*mid) - 0.5 * (x + layout.X.row(w).transpose())).norm());
-    }
-    to_old =
-        std::min(to_old, point_triangle_distance(old, x, layout.X.row(a).transpose(), layout.X.row(b).transpose()));
-  }
-  return std::max(error, to_old);
+  return star_surface_error(layout.X, F, stars, v, x, old, [&](int w) -> std::optional<Eigen::Vector3d> {
+    const std::optional<BasePoint> mid = domain.from_chart(c, 0.5 * (q + domain.to_chart(c, layout.points[w])));
+    if (!mid) return std::nullopt;
+    return lift.lift(*mid);
+  });
 }
 
 // Vertex v of a poor triangle to the candidate (repair_targets() at full, half and quarter
@@ -264,8 +252,9 @@ bool repair_vertex(const RowMatrixX3i& F, const VertexStars& stars, const BaseDo
                    const BaseRepairOptions& options, double mean_edge, int v, BaseLayout& layout) {
   const Eigen::Vector3d x = layout.X.row(v);
   const double current = star_quality(layout.X, F, stars, v, x);
+  if (!(current < options.threshold)) return false;
   const std::optional<Eigen::Vector3d> normal = vertex_normal(layout.X, F, stars, v);
-  if (!(current < options.threshold) || !normal) return false;
+  if (!normal) return false;
   const std::optional<std::array<Eigen::Vector3d, 3>> targets = repair_targets(layout.X, F, stars, v, *normal);
   const std::vector<BasePoint> points = star_points(F, stars, layout, v);
   const int c = domain.common_chart(points.data(), static_cast<int>(points.size()));
@@ -304,21 +293,6 @@ bool repair_vertex(const RowMatrixX3i& F, const VertexStars& stars, const BaseDo
   layout.points[v] = *best_point;
   layout.X.row(v) = best_x.transpose();
   return true;
-}
-
-double smallest_quality(const RowMatrixX3d& X, const RowMatrixX3i& F) {
-  double q = std::numeric_limits<double>::infinity();
-  for (int f = 0; f < F.rows(); ++f)
-    q = std::min(
-        q, frey_borouchaki_quality(X.row(F(f, 0)).transpose(), X.row(F(f, 1)).transpose(), X.row(F(f, 2)).transpose()));
-  return F.rows() > 0 ? q : 0.0;
-}
-
-double mean_edge_length(const RowMatrixX3d& X, const RowMatrixX3i& F) {
-  double sum = 0;
-  for (int f = 0; f < F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) sum += (X.row(F(f, k)) - X.row(F(f, (k + 1) % 3))).norm();
-  return sum / std::max<Eigen::Index>(1, 3 * F.rows());
 }
 
 }  // namespace

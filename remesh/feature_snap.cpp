@@ -24,11 +24,7 @@ int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMa
   std::vector<int> face_of(input_vertices, -1);  // one face of the input around each of its vertices
   for (int f = 0; f < input_F.rows(); ++f)
     for (int k = 0; k < 3; ++k) face_of[input_F(f, k)] = f;
-  double mean_edge = 0;
-  for (int f = 0; f < m; ++f)
-    for (int k = 0; k < 3; ++k) mean_edge += (X.row(F(f, k)) - X.row(F(f, (k + 1) % 3))).norm();
-  mean_edge /= 3.0 * m;
-  const double threshold = options.min_distance * mean_edge;
+  const double threshold = options.min_distance * mean_edge_length(X, F);
 
   // The level face nearest to each input vertex, before any snap; the input vertices under
   // each level face (so that a snap can be judged on the input around it).

@@ -3,8 +3,9 @@
 /// Small pieces shared by the steps that move the vertices of a level over the input surface in
 /// 3D and carry each move back to the parameter domain D (shape_smoothing.h, triangle_repair.h,
 /// base_levels.h): the vertex normal, the no-flip check of a vertex's star in D, the smallest
-/// quality of a star, the point-triangle distance, the equilateral apex of an edge, the repair's
-/// targets, and the pull-back of a 3D move through the affine map of one input triangle.
+/// quality of a star and of a level, the mean edge length, the point-triangle distance, the
+/// equilateral apex of an edge, the repair's surface error, targets and retries, and the
+/// pull-back of a 3D move through the affine map of one input triangle.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -93,6 +94,47 @@ inline std::optional<Eigen::Vector3d> equilateral_apex(const Eigen::Vector3d& a,
   const Eigen::Vector3d side = normal.cross(e);
   if (!(side.norm() > 0)) return std::nullopt;
   return Eigen::Vector3d(0.5 * (a + b) + (std::sqrt(3.0) / 2.0) * e.norm() * side.normalized());
+}
+
+/// The mean length of the edges of (X, F), each counted once per face around it; 0 without faces.
+inline double mean_edge_length(const RowMatrixX3d& X, const RowMatrixX3i& F) {
+  double sum = 0;
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) sum += (X.row(F(f, k)) - X.row(F(f, (k + 1) % 3))).norm();
+  return sum / std::max<Eigen::Index>(1, 3 * F.rows());
+}
+
+/// The smallest Frey–Borouchaki Q of the triangles of (X, F); 0 without faces.
+inline double smallest_quality(const RowMatrixX3d& X, const RowMatrixX3i& F) {
+  double q = std::numeric_limits<double>::infinity();
+  for (int f = 0; f < F.rows(); ++f)
+    q = std::min(
+        q, frey_borouchaki_quality(X.row(F(f, 0)).transpose(), X.row(F(f, 1)).transpose(), X.row(F(f, 2)).transpose()));
+  return F.rows() > 0 ? q : 0.0;
+}
+
+/// How far v's triangles, with v at x, leave the surface, for the repair's guard: the largest
+/// distance between an edge's 3D midpoint and `lifted_midpoint(w)`, the lift of the midpoint of
+/// the edge v–w in D (nullopt where there is none: the error is then infinite), and the distance
+/// from `old` (v before the move, on the surface) to the triangles: a move off a ridge or a tip
+/// leaves it away from them. The neighbours are visited in the order of v's star.
+template <class LiftedMidpoint>
+double star_surface_error(const RowMatrixX3d& X, const RowMatrixX3i& F, const VertexStars& stars, int v,
+                          const Eigen::Vector3d& x, const Eigen::Vector3d& old, LiftedMidpoint&& lifted_midpoint) {
+  double error = 0, to_old = std::numeric_limits<double>::infinity();
+  for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
+    const int f = stars.faces[i];
+    int k = 0;
+    while (F(f, k) != v) ++k;
+    const int a = F(f, (k + 1) % 3), b = F(f, (k + 2) % 3);
+    for (const int w : {a, b}) {
+      const std::optional<Eigen::Vector3d> mid = lifted_midpoint(w);
+      if (!mid) return std::numeric_limits<double>::infinity();
+      error = std::max(error, (*mid - 0.5 * (x + X.row(w).transpose())).norm());
+    }
+    to_old = std::min(to_old, point_triangle_distance(old, x, X.row(a).transpose(), X.row(b).transpose()));
+  }
+  return std::max(error, to_old);
 }
 
 /// Where the repair of the worst triangles (triangle_repair.h, base_levels.h) tries to move

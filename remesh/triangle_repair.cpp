@@ -36,38 +36,18 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
     const Eigen::Vector3d lifted = lift_location(surface_V, PF, loc);
     return options.project_onto ? Eigen::Vector3d(options.project_onto->closest(lifted).point) : lifted;
   };
-  // How far v's triangles (v at u in D, x in 3D) leave the surface: the largest distance
-  // between an edge's 3D midpoint and the lift of its midpoint in D, and (with `old` = v's
-  // position before the move, on the surface) the distance from `old` to the triangles: a
-  // move off a ridge or a tip leaves it away from them.
+  // How far v's triangles (v at u in D, x in 3D) leave the surface (star_surface_error), the
+  // midpoints lifted through D with one walking hint.
   auto surface_error = [&](int v, const Eigen::Vector3d& u, const Eigen::Vector3d& x, const Eigen::Vector3d& old) {
-    double error = 0, to_old = std::numeric_limits<double>::infinity();
     int hint = hints[v];
-    for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
-      const int f = stars.faces[i];
-      int k = 0;
-      while (F(f, k) != v) ++k;
-      const int a = F(f, (k + 1) % 3), b = F(f, (k + 2) % 3);
-      for (int w : {a, b}) {
-        const Eigen::Vector3d mid = project_to_domain(kind, 0.5 * (u + U.row(w).transpose()), false);
-        error = std::max(error, (lift(mid, hint) - 0.5 * (x + X.row(w).transpose())).norm());
-      }
-      to_old = std::min(to_old, point_triangle_distance(old, x, X.row(a).transpose(), X.row(b).transpose()));
-    }
-    return std::max(error, to_old);
+    return star_surface_error(X, F, stars, v, x, old, [&](int w) -> std::optional<Eigen::Vector3d> {
+      return lift(project_to_domain(kind, 0.5 * (u + U.row(w).transpose()), false), hint);
+    });
   };
-  double mean_edge = 0;
-  for (int f = 0; f < m; ++f)
-    for (int k = 0; k < 3; ++k) mean_edge += (X.row(F(f, k)) - X.row(F(f, (k + 1) % 3))).norm();
-  mean_edge /= std::max(1, 3 * m);
-  auto smallest_q = [&]() {
-    double q = std::numeric_limits<double>::infinity();
-    for (int f = 0; f < m; ++f) q = std::min(q, quality(f, -1, Eigen::Vector3d::Zero()));
-    return m > 0 ? q : 0.0;
-  };
+  const double mean_edge = mean_edge_length(X, F);
 
   TriangleRepairStats stats;
-  stats.q_min_before = smallest_q();
+  stats.q_min_before = smallest_quality(X, F);
   std::vector<std::pair<double, int>> poor;
   std::vector<int> visited(n, -1);
   RepairRetries retries(F, stars, n);
@@ -134,7 +114,7 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
     stats.moves += moved;
     if (moved == 0) break;
   }
-  stats.q_min_after = smallest_q();
+  stats.q_min_after = smallest_quality(X, F);
   return stats;
 }
 
