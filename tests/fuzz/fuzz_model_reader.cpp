@@ -11,7 +11,10 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -41,6 +44,31 @@ void write_bytes(const fs::path& path, const std::uint8_t* data, std::size_t siz
   f.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
 }
 
+// The template's files (path relative to it, bytes), read once. Each input writes them out
+// through streams, which retry an interrupted write: std::filesystem::copy does not, and
+// libFuzzer's timer signal can interrupt its copy ("cannot copy: Interrupted system call").
+const std::vector<std::pair<fs::path, std::string>>& template_files() {
+  static const std::vector<std::pair<fs::path, std::string>> files = [] {
+    std::vector<std::pair<fs::path, std::string>> read;
+    const fs::path root = template_model();
+    for (const fs::directory_entry& entry : fs::recursive_directory_iterator(root))
+      if (entry.is_regular_file()) {
+        std::ifstream in(entry.path(), std::ios::binary);
+        read.emplace_back(fs::relative(entry.path(), root),
+                          std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()));
+      }
+    return read;
+  }();
+  return files;
+}
+
+void write_template(const fs::path& work) {
+  for (const auto& [relative, bytes] : template_files()) {
+    fs::create_directories((work / relative).parent_path());
+    write_bytes(work / relative, reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
+  }
+}
+
 std::string hex64(std::uint64_t v) {
   char buf[17];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
@@ -53,7 +81,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   const fs::path work = "/tmp/mrsnake-fuzz-model-" + std::to_string(getpid());
   fs::remove_all(work);
-  fs::copy(template_model(), work, fs::copy_options::recursive);
+  write_template(work);
   const std::uint8_t* body = data + 1;
   const std::size_t body_size = size - 1;
   if (data[0] % 2 == 0) {
