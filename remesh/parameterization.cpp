@@ -496,7 +496,8 @@ namespace {
 // A one-chart map that flipped triangles or squeezed a protrusion past what doubles resolve is
 // replaced by the hierarchical one, which bounds the squeeze at the price of anisotropy: the
 // one-chart maps stay first, being conformal, where they work.
-void fall_back_to_hierarchical_map(const TriMesh& mesh, Parameterization& param) {
+void fall_back_to_hierarchical_map(const TriMesh& mesh, const ParameterizationOptions& options,
+                                   Parameterization& param) {
   const int flipped = count_flipped(param.domain, mesh.F);
   const double spread = stretch_spread_log10(mesh, param.domain);
   if (flipped == 0 && spread <= max_stretch_spread_log10) return;
@@ -505,6 +506,7 @@ void fall_back_to_hierarchical_map(const TriMesh& mesh, Parameterization& param)
                   : "hierarchical: the one-chart map's area stretch spans " + std::to_string(static_cast<int>(spread)) +
                         " orders of magnitude";
   param.sphere_map = SphereMap::hierarchical;
+  if (options.on_hierarchical_fallback) options.on_hierarchical_fallback();
   param.domain = hierarchical_sphere_map(mesh);
   param.cut.clear();
 }
@@ -584,7 +586,7 @@ Parameterization parameterize(const TriMesh& input, const ParameterizationOption
     } else {
       orient_and_balance();
     }
-    if (options.sphere_map == SphereMap::automatic) fall_back_to_hierarchical_map(mesh, param);
+    if (options.sphere_map == SphereMap::automatic) fall_back_to_hierarchical_map(mesh, options, param);
     param.summary["sphere_map"] = param.sphere_map == SphereMap::two_halves     ? "two_halves"
                                   : param.sphere_map == SphereMap::hierarchical ? "hierarchical"
                                                                                 : "punctured";

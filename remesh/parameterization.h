@@ -14,6 +14,7 @@
 ///   arc length, so they agree there). The map is continuous, with a kink along the cut.
 /// Either is then balanced by Möbius transformations until the area-weighted centroid sits at
 /// the centre. No seam in D.
+#include <functional>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -48,6 +49,9 @@ struct ParameterizationOptions {
   /// With automatic: the face count from which the two-halves map is used (it solves faster on
   /// large inputs; docs/remesh.md, "Tuning knobs").
   int halves_from_faces = 100000;
+  /// With automatic: called once, before the hierarchical map replaces a one-chart map that
+  /// failed (the automatic domain starts the base-mesh route then, on the other core).
+  std::function<void()> on_hierarchical_fallback;
 };
 
 /// The input surface T embedded in D.

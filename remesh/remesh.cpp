@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
+#include <future>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -95,10 +99,11 @@ struct MappedInput {
 };
 
 MappedInput map_onto_domain(const PreparedInput& input, SphereMap sphere_map, bool needs_locator,
-                            const ProgressFn& progress) {
+                            const ProgressFn& progress, const std::function<void()>& on_hierarchical_fallback) {
   report(progress, "parameterize", 0);
   ParameterizationOptions param_options;
   param_options.sphere_map = sphere_map;
+  param_options.on_hierarchical_fallback = on_hierarchical_fallback;
   MappedInput m;
   m.locator = map_beside_locator(input, needs_locator, [&] { m.param = parameterize(input.work, param_options); });
   return m;
@@ -350,7 +355,9 @@ RemeshLevel build_level(const LevelContext& ctx, const RemeshOptions& options, i
 }
 
 // The sphere route: the input mapped onto the unit sphere or disk, the base in D, the levels.
-RemeshResult remesh_on_sphere(const TriMesh& input, const RemeshOptions& options) {
+// `on_hierarchical_fallback` is called when the one-chart sphere map fails.
+RemeshResult remesh_on_sphere(const TriMesh& input, const RemeshOptions& options,
+                              const std::function<void()>& on_hierarchical_fallback = {}) {
   RemeshResult result;
   const auto start = Clock::now();
   Resolution resolution = initial_resolution(options);
@@ -360,7 +367,8 @@ RemeshResult remesh_on_sphere(const TriMesh& input, const RemeshOptions& options
   const int fit_rounds = options.relax == RelaxMode::all_vertices ? options.fit.rounds : 0;
   const bool needs_locator =
       prepared.simplified || fit_rounds > 0 || options.compute_stats || options.keep_input_locator;
-  const MappedInput mapped = map_onto_domain(prepared, options.sphere_map, needs_locator, options.progress);
+  const MappedInput mapped =
+      map_onto_domain(prepared, options.sphere_map, needs_locator, options.progress, on_hierarchical_fallback);
   const Parameterization& param = mapped.param;
   result.input_locator = mapped.locator;
   result.domain = param.kind == DomainKind::sphere ? "sphere" : "disk";
@@ -409,48 +417,93 @@ bool on_the_hierarchical_map(const RemeshResult& r) {
   return r.domain == "sphere" && r.parameterization.value("sphere_map", "") == "hierarchical";
 }
 
-// The options with every progress stage named after `prefix`: the second domain's stages
-// repeat the first's names.
-RemeshOptions with_stage_prefix(const RemeshOptions& options, const std::string& prefix) {
-  RemeshOptions prefixed = options;
+// The options with every progress stage named after `prefix` (the second domain's stages
+// repeat the first's names) and reported under `lock`: the two domains report from two threads.
+RemeshOptions with_locked_progress(const RemeshOptions& options, const std::shared_ptr<std::mutex>& lock,
+                                   const std::string& prefix) {
+  RemeshOptions locked = options;
   if (options.progress)
-    prefixed.progress = [progress = options.progress, prefix](const std::string& stage, double fraction) {
+    locked.progress = [progress = options.progress, lock, prefix](const std::string& stage, double fraction) {
+      const std::lock_guard<std::mutex> hold(*lock);
       progress(prefix + stage, fraction);
     };
-  return prefixed;
+  return locked;
+}
+
+// The base-mesh route's result and score, or why it failed.
+struct BaseOutcome {
+  std::optional<RemeshResult> result;
+  FinestLevelScore score;
+  std::string error;
+};
+
+// The base-mesh route, run on another thread from the moment the sphere route's one-chart map
+// fails, beside the hierarchical map and the sphere's levels: the automatic domain then takes
+// about the longer route's time instead of both routes' sum. Its failure, for any reason, is
+// kept, not thrown. Destroyed while running (the sphere route threw), it waits for the end.
+class BaseRouteBeside {
+ public:
+  BaseRouteBeside(const TriMesh& input, RemeshOptions options) : input_(input), options_(std::move(options)) {}
+
+  // Starts the route on another thread (once); without a thread, outcome() runs it.
+  void start() {
+    if (running_.valid()) return;
+    try {
+      running_ = std::async(std::launch::async, [this] { return run(); });
+    } catch (...) {  // std::system_error (no thread) or std::bad_alloc
+    }
+  }
+
+  BaseOutcome outcome() { return running_.valid() ? running_.get() : run(); }
+
+ private:
+  BaseOutcome run() const {
+    BaseOutcome out;
+    try {
+      out.result = remesh_on_base_mesh(input_, options_);
+      out.score = finest_level_score(*out.result);
+    } catch (const std::exception& e) {
+      out.result.reset();
+      out.error = e.what();
+    }
+    return out;
+  }
+
+  const TriMesh& input_;
+  const RemeshOptions options_;
+  std::future<BaseOutcome> running_;
+};
+
+// A result's own time: its parameterization's and its levels'.
+double own_seconds(const RemeshResult& r) {
+  double seconds = r.parameterization.value("seconds", 0.0);
+  for (const auto& level : r.levels) seconds += level.seconds;
+  return seconds;
 }
 
 // Both domains' finest levels compared: fewer self-intersections, then the higher mean
-// quality. If the base mesh fails, for any reason, the sphere's valid result is kept and the
-// failure recorded. The choice's "seconds" are those of the domain not kept and of the
-// comparison, which remesh_report adds to the total.
-RemeshResult better_of_both_domains(RemeshResult on_sphere, double sphere_seconds, const TriMesh& input,
-                                    const RemeshOptions& options) {
-  const auto start = Clock::now();
+// quality. If the base mesh failed, the sphere's valid result is kept and the failure
+// recorded. The choice's "seconds" are the wall time since `start` less the kept result's own
+// (the other domain, where it did not overlap, and the comparison): remesh_report's total is
+// then the wall time.
+RemeshResult better_of_both_domains(RemeshResult on_sphere, BaseOutcome on_base, Clock::time_point start) {
   const FinestLevelScore sphere_score = finest_level_score(on_sphere);
   nlohmann::json choice = {{"sphere", score_json(sphere_score)},
                            {"sphere_map_fallback", on_sphere.parameterization.value("sphere_map_fallback", "")}};
   RemeshResult chosen;
-  double kept_seconds = 0;  // of the result kept, already in its own seconds
-  try {
-    const auto base_start = Clock::now();
-    RemeshResult on_base = remesh_on_base_mesh(input, with_stage_prefix(options, "base-mesh domain: "));
-    const double base_seconds = seconds_since(base_start);
-    const FinestLevelScore base_score = finest_level_score(on_base);
-    choice["base_mesh"] = score_json(base_score);
-    const bool base_wins = base_score.self_intersections != sphere_score.self_intersections
-                               ? base_score.self_intersections < sphere_score.self_intersections
-                               : base_score.q_mean > sphere_score.q_mean;
-    chosen = base_wins ? std::move(on_base) : std::move(on_sphere);
-    kept_seconds = base_wins ? base_seconds : 0.0;
-  } catch (const std::exception& e) {
-    choice["base_mesh"] = {{"error", e.what()}};
+  if (on_base.result) {
+    choice["base_mesh"] = score_json(on_base.score);
+    const bool base_wins = on_base.score.self_intersections != sphere_score.self_intersections
+                               ? on_base.score.self_intersections < sphere_score.self_intersections
+                               : on_base.score.q_mean > sphere_score.q_mean;
+    chosen = base_wins ? std::move(*on_base.result) : std::move(on_sphere);
+  } else {
+    choice["base_mesh"] = {{"error", on_base.error}};
     chosen = std::move(on_sphere);
   }
   choice["chosen"] = chosen.domain;
   choice["rule"] = "fewer self-intersections at the finest level, then the higher mean quality";
-  const bool sphere_kept = chosen.domain != "base_mesh";
-  choice["seconds"] = seconds_since(start) - kept_seconds + (sphere_kept ? 0.0 : sphere_seconds);
+  choice["seconds"] = std::max(0.0, seconds_since(start) - own_seconds(chosen));
   chosen.parameterization["domain_choice"] = choice;
   return chosen;
 }
@@ -461,14 +514,18 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   check_options(options);
   if (input.empty()) throw InputError("the mesh has no faces");
   if (options.domain == ParameterDomain::base_mesh) return remesh_on_base_mesh(input, options);
-  const auto start = Clock::now();
-  RemeshResult on_sphere = remesh_on_sphere(input, options);
   // The paper's variants (--strict, --no-relax) stay on the sphere, as the paper builds them,
   // and so does a sphere map the caller chose.
   if (options.domain == ParameterDomain::sphere || options.relax != RelaxMode::all_vertices ||
-      options.sphere_map != SphereMap::automatic || !on_the_hierarchical_map(on_sphere))
-    return on_sphere;
-  return better_of_both_domains(std::move(on_sphere), seconds_since(start), input, options);
+      options.sphere_map != SphereMap::automatic)
+    return remesh_on_sphere(input, options);
+  const auto start = Clock::now();
+  const auto progress_lock = std::make_shared<std::mutex>();
+  BaseRouteBeside on_base(input, with_locked_progress(options, progress_lock, "base-mesh domain: "));
+  RemeshResult on_sphere =
+      remesh_on_sphere(input, with_locked_progress(options, progress_lock, ""), [&] { on_base.start(); });
+  if (!on_the_hierarchical_map(on_sphere)) return on_sphere;
+  return better_of_both_domains(std::move(on_sphere), on_base.outcome(), start);
 }
 
 nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& options) {

@@ -60,7 +60,13 @@ TEST(HierarchicalMap, OfASphereIsNearlyASimilarity) {
 
 TEST(HierarchicalMap, TheAutomaticSphereMapFallsBackToItAndEveryLevelIsFlipFree) {
   const TriMesh tube = test::capsule(30.0);
-  const Parameterization param = parameterize(tube);
+  ParameterizationOptions told;
+  int fallbacks = 0;
+  told.on_hierarchical_fallback = [&] { ++fallbacks; };
+  const Parameterization param = parameterize(tube, told);
+  EXPECT_EQ(fallbacks, 1);  // the automatic domain starts the base-mesh route on it
+  EXPECT_EQ(parameterize(icosphere(3), told).sphere_map, SphereMap::punctured);
+  EXPECT_EQ(fallbacks, 1);  // no fallback, no call
   EXPECT_EQ(param.sphere_map, SphereMap::hierarchical);
   EXPECT_EQ(param.summary["sphere_map"], "hierarchical");
   EXPECT_NE(param.summary.value("sphere_map_fallback", std::string()).find("hierarchical: the one-chart map"),
