@@ -444,6 +444,8 @@ struct BaseOutcome {
 class BaseRouteBeside {
  public:
   BaseRouteBeside(const TriMesh& input, RemeshOptions options) : input_(input), options_(std::move(options)) {}
+  BaseRouteBeside(const BaseRouteBeside&) = delete;  // the running thread holds `this`
+  BaseRouteBeside& operator=(const BaseRouteBeside&) = delete;
 
   // Starts the route on another thread (once); without a thread, outcome() runs it.
   void start() {
