@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <functional>
 #include <future>
 #include <memory>
@@ -510,6 +511,34 @@ RemeshResult better_of_both_domains(RemeshResult on_sphere, BaseOutcome on_base,
   return chosen;
 }
 
+// The sphere route failed (an AlgorithmError, `sphere_failure`): the base mesh's result, when it
+// has one, with the failure recorded, else the sphere's failure rethrown.
+RemeshResult base_instead_of_sphere(BaseOutcome on_base, const std::exception_ptr& sphere_failure,
+                                    Clock::time_point start) {
+  if (!on_base.result) std::rethrow_exception(sphere_failure);
+  std::string sphere_error;
+  try {
+    std::rethrow_exception(sphere_failure);
+  } catch (const std::exception& e) {
+    sphere_error = e.what();
+  }
+  RemeshResult kept = std::move(*on_base.result);
+  kept.parameterization["domain_choice"] = {
+      {"sphere", {{"error", sphere_error}}},
+      {"base_mesh", score_json(on_base.score)},
+      {"chosen", kept.domain},
+      {"rule", "the sphere's route failed"},
+      {"seconds", std::max(0.0, seconds_since(start) - own_seconds(kept))}};
+  return kept;
+}
+
+// Quality and distance to the input of every level, as build_level measures them.
+void measure_levels(const TriMesh& input, RemeshResult& result) {
+  const TriMesh original = remove_unreferenced_vertices(input);
+  for (int j = 0; j < static_cast<int>(result.levels.size()); ++j)
+    measure_level(original, *result.input_locator, result.connectivity.faces[j], result.levels[j]);
+}
+
 }  // namespace
 
 RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
@@ -522,12 +551,26 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
       options.sphere_map != SphereMap::automatic)
     return remesh_on_sphere(input, options);
   const auto start = Clock::now();
+  // The levels are measured once the kept domain is known: the other domain's would be thrown
+  // away. Both domains' times then leave the measuring out, as a single domain's do.
+  RemeshOptions unmeasured = options;
+  unmeasured.compute_stats = false;
+  unmeasured.keep_input_locator = options.keep_input_locator || options.compute_stats;
   const auto progress_lock = std::make_shared<std::mutex>();
-  BaseRouteBeside on_base(input, with_locked_progress(options, progress_lock, "base-mesh domain: "));
-  RemeshResult on_sphere =
-      remesh_on_sphere(input, with_locked_progress(options, progress_lock, ""), [&] { on_base.start(); });
-  if (!on_the_hierarchical_map(on_sphere)) return on_sphere;
-  return better_of_both_domains(std::move(on_sphere), on_base.outcome(), start);
+  BaseRouteBeside on_base(input, with_locked_progress(unmeasured, progress_lock, "base-mesh domain: "));
+  std::optional<RemeshResult> on_sphere;
+  std::exception_ptr sphere_failure;
+  try {
+    on_sphere = remesh_on_sphere(input, with_locked_progress(unmeasured, progress_lock, ""), [&] { on_base.start(); });
+  } catch (const AlgorithmError&) {  // the base mesh may still hold the shape (built now, if not begun)
+    sphere_failure = std::current_exception();
+  }
+  RemeshResult kept = !on_sphere ? base_instead_of_sphere(on_base.outcome(), sphere_failure, start)
+                      : on_the_hierarchical_map(*on_sphere)
+                          ? better_of_both_domains(std::move(*on_sphere), on_base.outcome(), start)
+                          : std::move(*on_sphere);
+  if (options.compute_stats) measure_levels(input, kept);
+  return kept;
 }
 
 nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& options) {

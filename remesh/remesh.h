@@ -35,7 +35,8 @@ enum class ParameterDomain {
   /// `sphere`; where the one-chart map of a closed surface fails and the automatic sphere map
   /// falls back on the hierarchical one (protrusions: legs, fingers, horns), `base_mesh` is
   /// built too, and the finest level with fewer self-intersections, then the higher mean
-  /// quality, is kept (default).
+  /// quality, is kept; where the sphere route fails (AlgorithmError), the base mesh's result
+  /// stands in for it (default).
   automatic,
   /// The input mapped as a whole onto the unit sphere (closed) or the unit disk (a disk):
   /// remesh/parameterization.h.
@@ -205,7 +206,8 @@ void check_options(const RemeshOptions& options, const std::string& at = "");
 /// \throw TopologyError if the input is not a disk or a closed genus-0 surface (the message
 ///        names what was found).
 /// \throw AlgorithmError if the parameterization fails or is too distorted, or a level cannot
-///        be built without flipped triangles; nothing partial is returned.
+///        be built without flipped triangles (on the automatic domain: on both domains, with
+///        the sphere route's message); nothing partial is returned.
 /// \throw OptionsError if check_options refuses the options.
 RemeshResult remesh(const TriMesh& input, const RemeshOptions& options);
 

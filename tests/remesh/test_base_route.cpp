@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "mesh/distance.h"
+#include "mesh/errors.h"
 #include "mesh/mesh_io.h"
 #include "mesh/primitives.h"
 #include "mesh/quality.h"
@@ -366,6 +367,7 @@ TEST(BaseDomainRemesh, ADiskRimSlidesAlongTheInputRimToEvenLengths) {
 TEST(AutomaticDomain, AShapeOneChartCannotHoldKeepsTheBetterOfBothDomains) {
   RemeshOptions o;
   o.target_faces = 4096;
+  o.compute_stats = false;  // measured after the choice, out of the times checked below
   std::map<std::thread::id, std::vector<std::string>> stages_by_thread;
   std::atomic<int> reporting{0};
   int most_reporting = 0;
@@ -413,6 +415,41 @@ TEST(AutomaticDomain, AShapeOneChartCannotHoldKeepsTheBetterOfBothDomains) {
   const RemeshResult plain = remesh(test::ellipsoid(3), o);
   EXPECT_EQ(plain.domain, "sphere");
   EXPECT_FALSE(plain.parameterization.contains("domain_choice"));
+}
+
+// Where the sphere route fails (here its progress callback throws at its first level), the base
+// mesh's result stands in: on a capsule it was built beside the hierarchical map, on an
+// ellipsoid (one chart holds it) it is built then. Either is measured as a kept domain is. Both
+// failing report the sphere's error.
+TEST(AutomaticDomain, TheBaseMeshStandsInWhereTheSphereRouteFails) {
+  RemeshOptions o;
+  o.target_faces = 1024;
+  std::set<std::string> failing_stages = {"level 0"};
+  o.progress = [&](const std::string& stage, double) {
+    if (failing_stages.count(stage)) throw AlgorithmError("no " + stage);
+  };
+  for (const TriMesh& shape : {test::capsule(40.0), test::ellipsoid(3)}) {
+    const RemeshResult r = remesh(shape, o);
+    ASSERT_EQ(r.domain, "base_mesh");
+    const nlohmann::json& choice = r.parameterization["domain_choice"];
+    EXPECT_EQ(choice["sphere"]["error"], "no level 0");
+    EXPECT_EQ(choice["chosen"], "base_mesh");
+    EXPECT_EQ(choice["base_mesh"]["self_intersections"].get<int>(),
+              count_self_intersections(r.mesh(static_cast<int>(r.levels.size()) - 1)));
+    expect_valid_hierarchy(r, shape);
+    for (int j = 0; j < static_cast<int>(r.levels.size()); ++j) {
+      const nlohmann::json& stats = r.levels[j].stats;
+      ASSERT_TRUE(stats.contains("quality") && stats.contains("distance")) << "level " << j;
+      EXPECT_DOUBLE_EQ(stats["quality"]["q_mean"].get<double>(), mesh_quality(r.mesh(j)).q_mean);
+    }
+  }
+  failing_stages.insert("base-mesh domain: level 0");
+  try {
+    remesh(test::capsule(40.0), o);
+    ADD_FAILURE() << "both domains failed, and remesh returned";
+  } catch (const AlgorithmError& e) {
+    EXPECT_STREQ(e.what(), "no level 0");
+  }
 }
 
 TEST(BaseDomainRemesh, OptionNameRoundTripsThroughJson) {
