@@ -523,12 +523,11 @@ RemeshResult base_instead_of_sphere(BaseOutcome on_base, const std::exception_pt
     sphere_error = e.what();
   }
   RemeshResult kept = std::move(*on_base.result);
-  kept.parameterization["domain_choice"] = {
-      {"sphere", {{"error", sphere_error}}},
-      {"base_mesh", score_json(on_base.score)},
-      {"chosen", kept.domain},
-      {"rule", "the sphere's route failed"},
-      {"seconds", std::max(0.0, seconds_since(start) - own_seconds(kept))}};
+  kept.parameterization["domain_choice"] = {{"sphere", {{"error", sphere_error}}},
+                                            {"base_mesh", score_json(on_base.score)},
+                                            {"chosen", kept.domain},
+                                            {"rule", "the sphere's route failed"},
+                                            {"seconds", std::max(0.0, seconds_since(start) - own_seconds(kept))}};
   return kept;
 }
 
