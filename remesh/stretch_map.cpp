@@ -17,19 +17,30 @@ using FaceLists = std::vector<std::vector<int>>;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kPi = 3.14159265358979323846;
 
+// The surface side of a face's map: the squared lengths |l_k|² of its edges, l_k opposite
+// corner k, and twice its area. Constant while D moves: StarRelaxer keeps them per face.
+struct SurfaceTriangle {
+  std::array<double, 3> squared_lengths;
+  double double_area;
+};
+
+SurfaceTriangle surface_triangle(const Vec3& q0, const Vec3& q1, const Vec3& q2) {
+  return {{(q2 - q1).squaredNorm(), (q0 - q2).squaredNorm(), (q1 - q0).squaredNorm()}, (q1 - q0).cross(q2 - q0).norm()};
+}
+
 // ‖J‖²_F of the affine map from the domain triangle to the surface triangle, and its
 // determinant (the area ratio), or NaN when the triangle is flat or flipped in D. With a_k, b_k
 // the domain edges at corner k and l_k the surface edge opposite it, the Dirichlet energy gives
 // ‖J‖² = Σ_k (a_k·b_k)|l_k|² / (2 A_D)². On the sphere, orientation = 2 A_D x the chord plane's
 // distance from the centre: using it for 2 A_D keeps a coarse triangle from growing to a
 // hemisphere, where its chord plane reaches the centre and the triangle turns over.
-std::pair<double, double> jacobian_norm_and_det(const Vec3& d0, const Vec3& d1, const Vec3& d2, const Vec3& q0,
-                                                const Vec3& q1, const Vec3& q2) {
+std::pair<double, double> jacobian_norm_and_det(const Vec3& d0, const Vec3& d1, const Vec3& d2,
+                                                const SurfaceTriangle& q) {
   const double orientation = domain_orientation(d0, d1, d2);
   if (!(orientation > 0)) return {std::nan(""), std::nan("")};
-  const double s = (d1 - d0).dot(d2 - d0) * (q2 - q1).squaredNorm() + (d2 - d1).dot(d0 - d1) * (q0 - q2).squaredNorm() +
-                   (d0 - d2).dot(d1 - d2) * (q1 - q0).squaredNorm();
-  return {s / (orientation * orientation), (q1 - q0).cross(q2 - q0).norm() / orientation};
+  const double s = (d1 - d0).dot(d2 - d0) * q.squared_lengths[0] + (d2 - d1).dot(d0 - d1) * q.squared_lengths[1] +
+                   (d0 - d2).dot(d1 - d2) * q.squared_lengths[2];
+  return {s / (orientation * orientation), q.double_area / orientation};
 }
 
 // A3D (‖J‖²/det + λ (det + 1/det)) of a face whose surface was scaled to the domain's area:
@@ -37,11 +48,10 @@ std::pair<double, double> jacobian_norm_and_det(const Vec3& d0, const Vec3& d1, 
 // stay round on the surface, and the area term (λ = area_weight) bounds the squeeze that a
 // conformal map puts on a protrusion. Both grow without bound as a face goes flat in D.
 // Infinite when the face is flat or flipped in D.
-double face_energy(const Vec3& d0, const Vec3& d1, const Vec3& d2, const Vec3& q0, const Vec3& q1, const Vec3& q2,
-                   double area_weight) {
-  const auto [norm2, det] = jacobian_norm_and_det(d0, d1, d2, q0, q1, q2);
+double face_energy(const Vec3& d0, const Vec3& d1, const Vec3& d2, const SurfaceTriangle& q, double area_weight) {
+  const auto [norm2, det] = jacobian_norm_and_det(d0, d1, d2, q);
   if (!(det > 0)) return std::isnan(det) ? kInf : 0.0;
-  return 0.5 * (q1 - q0).cross(q2 - q0).norm() * (norm2 / det + area_weight * (det + 1 / det));
+  return 0.5 * q.double_area * (norm2 / det + area_weight * (det + 1 / det));
 }
 
 // The surface scaled to the area of the unit sphere: the area term's minimum is then an
@@ -78,7 +88,7 @@ class StarRelaxer {
     for (int f : faces_of_[v]) {
       Vec3 d[3];
       for (int k = 0; k < 3; ++k) d[k] = F_(f, k) == v ? p : Vec3(D_.row(F_(f, k)));
-      e += face_energy(d[0], d[1], d[2], X_.row(F_(f, 0)), X_.row(F_(f, 1)), X_.row(F_(f, 2)), area_weight_);
+      e += face_energy(d[0], d[1], d[2], surface_of(f), area_weight_);
       if (!std::isfinite(e)) return kInf;
     }
     return e;
@@ -141,11 +151,30 @@ class StarRelaxer {
     return {height, count > 0 ? sum / count : 0.0};
   }
 
+  /// Face f's surface triangle, computed again only when its corners changed (a split or a
+  /// collapse rewrites faces): the energy is evaluated some 10⁷ times on 10⁵ faces.
+  const SurfaceTriangle& surface_of(int f) const {
+    if (f >= static_cast<int>(surface_.size())) surface_.resize(F_.rows());
+    Cached& c = surface_[f];
+    const std::array<int, 3> corners{F_(f, 0), F_(f, 1), F_(f, 2)};
+    if (c.corners != corners) {
+      c.corners = corners;
+      c.triangle = surface_triangle(X_.row(corners[0]), X_.row(corners[1]), X_.row(corners[2]));
+    }
+    return c.triangle;
+  }
+
+  struct Cached {
+    std::array<int, 3> corners{-1, -1, -1};
+    SurfaceTriangle triangle{};
+  };
+
   const RowMatrixX3d& X_;
   const RowMatrixX3i& F_;
   const FaceLists& faces_of_;
   RowMatrixX3d& D_;
   double area_weight_;
+  mutable std::vector<Cached> surface_;  // a cache: star_energy stays const
 };
 
 /// Sweeps over `vertices` until one lowers the energy by less than `tolerance` (relative) or
@@ -359,8 +388,8 @@ double map_energy(const TriMesh& mesh, const RowMatrixX3d& domain, double area_w
   double e = 0;
   for (int f = 0; f < mesh.num_faces(); ++f) {
     const int a = mesh.F(f, 0), b = mesh.F(f, 1), c = mesh.F(f, 2);
-    e += face_energy(domain.row(a), domain.row(b), domain.row(c), mesh.V.row(a), mesh.V.row(b), mesh.V.row(c),
-                     area_weight);
+    e += face_energy(domain.row(a), domain.row(b), domain.row(c),
+                     surface_triangle(mesh.V.row(a), mesh.V.row(b), mesh.V.row(c)), area_weight);
   }
   return e;
 }
@@ -373,7 +402,7 @@ double normalized_stretch(const TriMesh& mesh, const RowMatrixX3d& domain) {
     const double a3 = 0.5 * (b - a).cross(c - a).norm();
     area3 += a3;
     aread += 0.5 * (q - p).cross(r - p).norm();
-    weighted += a3 * 0.5 * jacobian_norm_and_det(p, q, r, a, b, c).first;
+    weighted += a3 * 0.5 * jacobian_norm_and_det(p, q, r, surface_triangle(a, b, c)).first;
   }
   return std::sqrt(weighted / area3 * aread / area3);
 }
