@@ -156,10 +156,10 @@ class StarRelaxer {
   const SurfaceTriangle& surface_of(int f) const {
     if (f >= static_cast<int>(surface_.size())) surface_.resize(F_.rows());
     Cached& c = surface_[f];
-    const std::array<int, 3> corners{F_(f, 0), F_(f, 1), F_(f, 2)};
-    if (c.corners != corners) {
-      c.corners = corners;
-      c.triangle = surface_triangle(X_.row(corners[0]), X_.row(corners[1]), X_.row(corners[2]));
+    const int a = F_(f, 0), b = F_(f, 1), d = F_(f, 2);
+    if (c.corners[0] != a || c.corners[1] != b || c.corners[2] != d) {  // (std::array's != calls memcmp)
+      c.corners = {a, b, d};
+      c.triangle = surface_triangle(X_.row(a), X_.row(b), X_.row(d));
     }
     return c.triangle;
   }
