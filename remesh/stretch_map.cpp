@@ -34,8 +34,8 @@ SurfaceTriangle surface_triangle(const Vec3& q0, const Vec3& q1, const Vec3& q2)
 // ‖J‖² = Σ_k (a_k·b_k)|l_k|² / (2 A_D)². On the sphere, orientation = 2 A_D x the chord plane's
 // distance from the centre: using it for 2 A_D keeps a coarse triangle from growing to a
 // hemisphere, where its chord plane reaches the centre and the triangle turns over.
-std::pair<double, double> jacobian_norm_and_det(const Vec3& d0, const Vec3& d1, const Vec3& d2,
-                                                const SurfaceTriangle& q) {
+inline std::pair<double, double> jacobian_norm_and_det(const Vec3& d0, const Vec3& d1, const Vec3& d2,
+                                                       const SurfaceTriangle& q) {
   const double orientation = domain_orientation(d0, d1, d2);
   if (!(orientation > 0)) return {std::nan(""), std::nan("")};
   const double s = (d1 - d0).dot(d2 - d0) * q.squared_lengths[0] + (d2 - d1).dot(d0 - d1) * q.squared_lengths[1] +
