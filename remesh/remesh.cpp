@@ -534,6 +534,7 @@ RemeshResult base_instead_of_sphere(BaseOutcome on_base, const std::exception_pt
 // Quality and distance to the input of every level, as build_level measures them.
 void measure_levels(const TriMesh& input, RemeshResult& result) {
   const TriMesh original = remove_unreferenced_vertices(input);
+  if (!result.input_locator) result.input_locator = std::make_shared<SurfaceLocator>(original);
   for (int j = 0; j < static_cast<int>(result.levels.size()); ++j)
     measure_level(original, *result.input_locator, result.connectivity.faces[j], result.levels[j]);
 }

@@ -152,7 +152,8 @@ class StarRelaxer {
   }
 
   /// Face f's surface triangle, computed again only when its corners changed (a split or a
-  /// collapse rewrites faces): the energy is evaluated some 10⁷ times on 10⁵ faces.
+  /// collapse rewrites faces): each relaxation step evaluates its star's energy five times or
+  /// more, and the hierarchical map spends most of its time there.
   const SurfaceTriangle& surface_of(int f) const {
     if (f >= static_cast<int>(surface_.size())) surface_.resize(F_.rows());
     Cached& c = surface_[f];
