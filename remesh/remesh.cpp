@@ -484,11 +484,22 @@ double own_seconds(const RemeshResult& r) {
   return seconds;
 }
 
+// `kept` with its parameterization's "domain_choice": `choice` (the domains' scores or errors),
+// the domain kept, the rule that kept it, and the "seconds": the wall time since `start` less
+// the kept result's own (the other domain, where it did not overlap, and the comparison), so
+// that remesh_report's total is the wall time up to the choice.
+RemeshResult with_domain_choice(RemeshResult kept, nlohmann::json choice, const std::string& rule,
+                                Clock::time_point start) {
+  choice["chosen"] = kept.domain;
+  choice["rule"] = rule;
+  choice["seconds"] = std::max(0.0, seconds_since(start) - own_seconds(kept));
+  kept.parameterization["domain_choice"] = std::move(choice);
+  return kept;
+}
+
 // Both domains' finest levels compared: fewer self-intersections, then the higher mean
 // quality. If the base mesh failed, the sphere's valid result is kept and the failure
-// recorded. The choice's "seconds" are the wall time since `start` less the kept result's own
-// (the other domain, where it did not overlap, and the comparison): remesh_report's total is
-// then the wall time.
+// recorded.
 RemeshResult better_of_both_domains(RemeshResult on_sphere, BaseOutcome on_base, Clock::time_point start) {
   const FinestLevelScore sphere_score = finest_level_score(on_sphere);
   nlohmann::json choice = {{"sphere", score_json(sphere_score)},
@@ -504,11 +515,8 @@ RemeshResult better_of_both_domains(RemeshResult on_sphere, BaseOutcome on_base,
     choice["base_mesh"] = {{"error", on_base.error}};
     chosen = std::move(on_sphere);
   }
-  choice["chosen"] = chosen.domain;
-  choice["rule"] = "fewer self-intersections at the finest level, then the higher mean quality";
-  choice["seconds"] = std::max(0.0, seconds_since(start) - own_seconds(chosen));
-  chosen.parameterization["domain_choice"] = choice;
-  return chosen;
+  return with_domain_choice(std::move(chosen), std::move(choice),
+                            "fewer self-intersections at the finest level, then the higher mean quality", start);
 }
 
 // The sphere route failed (an AlgorithmError, `sphere_failure`): the base mesh's result, when it
@@ -522,19 +530,14 @@ RemeshResult base_instead_of_sphere(BaseOutcome on_base, const std::exception_pt
   } catch (const std::exception& e) {
     sphere_error = e.what();
   }
-  RemeshResult kept = std::move(*on_base.result);
-  kept.parameterization["domain_choice"] = {{"sphere", {{"error", sphere_error}}},
-                                            {"base_mesh", score_json(on_base.score)},
-                                            {"chosen", kept.domain},
-                                            {"rule", "the sphere's route failed"},
-                                            {"seconds", std::max(0.0, seconds_since(start) - own_seconds(kept))}};
-  return kept;
+  nlohmann::json choice = {{"sphere", {{"error", sphere_error}}}, {"base_mesh", score_json(on_base.score)}};
+  return with_domain_choice(std::move(*on_base.result), std::move(choice), "the sphere's route failed", start);
 }
 
 // Quality and distance to the input of every level, as build_level measures them.
+// \pre result.input_locator was kept (RemeshOptions::keep_input_locator).
 void measure_levels(const TriMesh& input, RemeshResult& result) {
   const TriMesh original = remove_unreferenced_vertices(input);
-  if (!result.input_locator) result.input_locator = std::make_shared<SurfaceLocator>(original);
   for (int j = 0; j < static_cast<int>(result.levels.size()); ++j)
     measure_level(original, *result.input_locator, result.connectivity.faces[j], result.levels[j]);
 }

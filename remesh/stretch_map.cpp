@@ -80,7 +80,7 @@ class StarRelaxer {
  public:
   StarRelaxer(const RowMatrixX3d& surface, const RowMatrixX3i& F, const FaceLists& faces_of, RowMatrixX3d& D,
               double area_weight)
-      : X_(surface), F_(F), faces_of_(faces_of), D_(D), area_weight_(area_weight) {}
+      : X_(surface), F_(F), faces_of_(faces_of), D_(D), area_weight_(area_weight), surface_(F.rows()) {}
 
   /// The energy of v's star with v at p (infinite if a face flips or goes flat).
   double star_energy(int v, const Vec3& p) const {
@@ -152,10 +152,9 @@ class StarRelaxer {
   }
 
   /// Face f's surface triangle, computed again only when its corners changed (a split or a
-  /// collapse rewrites faces): each relaxation step evaluates its star's energy five times or
-  /// more, and the hierarchical map spends most of its time there.
+  /// collapse rewrites faces in place; F keeps its rows): each relaxation step evaluates its star's energy five times
+  /// or more, and the hierarchical map spends most of its time there.
   const SurfaceTriangle& surface_of(int f) const {
-    if (f >= static_cast<int>(surface_.size())) surface_.resize(F_.rows());
     Cached& c = surface_[f];
     const int a = F_(f, 0), b = F_(f, 1), d = F_(f, 2);
     if (c.corners[0] != a || c.corners[1] != b || c.corners[2] != d) {  // (std::array's != calls memcmp)
