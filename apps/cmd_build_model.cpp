@@ -101,7 +101,8 @@ BuiltModelSet build_with_hints(const Volume& labels, const Volume* image, const 
   }
 }
 
-// What the user should know of the surface: parts dropped, tunnels closed, a poor fit kept.
+// What the user should know of the surface: parts dropped, tunnels closed, a finest level that
+// crosses itself, a poor fit kept.
 void warn_about(const BuiltModel& built, const BuildModelOptions& o, int value) {
   const LabelSurface& s = built.surface;
   if (!s.dropped_component_faces.empty())
@@ -111,6 +112,10 @@ void warn_about(const BuiltModel& built, const BuildModelOptions& o, int value) 
   if (s.closing_radius > 0)
     warn("label " + std::to_string(value) + " had a genus-" + std::to_string(s.genus_before_repair) +
          " surface; closed its tunnels with a radius of " + std::to_string(s.closing_radius) + " voxels");
+  if (built.self_intersections > 0)
+    warn("label " + std::to_string(value) + ": the model's finest level passes through itself at " +
+         std::to_string(built.self_intersections) +
+         " face pairs, where the surface is thinner than its edges; more --faces make the edges shorter");
   if (!(built.fit.dice >= kMinLabelFitDice))
     warn(describe_poor_fit(built.fit) +
          poor_fit_cause(built.scale, choices_of(o, built.mc_spacing_mm, s.closing_radius)));
@@ -156,6 +161,7 @@ nlohmann::json summary_json(const BuildModelArgs& a, const BuiltModel& built, do
           {"scale", model.scale},
           {"closing_radius_voxels", built.surface.closing_radius},
           {"finest_level_quality", model.remesh_quality["finest_level_quality"]},
+          {"finest_level_self_intersections", built.self_intersections},
           {"detail_stats", stats},
           {"profile_alignment", built.alignment ? nlohmann::json(*built.alignment) : nlohmann::json()},
           {"timings", stages},

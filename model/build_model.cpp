@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mesh/distance.h"
 #include "mesh/label_repair.h"
 #include "mesh/option_checks.h"
 #include "mesh/stage_clock.h"
@@ -129,6 +130,7 @@ void record_provenance(const Volume& labels, const BuildModelOptions& options, B
   const RemeshResult& h = built.hierarchy;
   nlohmann::json quality = remesh_report(h, built.remesh);
   quality["finest_level_quality"] = mesh_quality(h.mesh(h.connectivity.levels()));
+  quality["finest_level_self_intersections"] = built.self_intersections;
   quality["input_faces"] = built.surface.mesh.num_faces();
   quality["marching_cubes"] = {{"spacing_mm", built.mc_spacing_mm},
                                {"smoothing_iterations", built.smoothing_iterations},
@@ -203,6 +205,7 @@ BuiltModel build_model(const Volume& labels_in, const Volume* image, const Build
   clock.end("analysis");
 
   check_fit(labels, options, built);
+  built.self_intersections = count_self_intersections(built.hierarchy.mesh(built.hierarchy.connectivity.levels()));
   clock.end("label_fit");
 
   if (image != nullptr) {

@@ -79,6 +79,7 @@ struct BuiltModel {
   LabelSurface surface;                   ///< the marching-cubes surface it remeshes
   StructureScale scale;                   ///< the structure's size
   LabelFit fit;                           ///< the finest level against the label
+  int self_intersections = 0;             ///< face pairs of the finest level that cross (0 for a valid surface)
   double mc_spacing_mm = 0;
   int smoothing_iterations = 0;
   std::optional<double> reference_margin_mm;            ///< with an image

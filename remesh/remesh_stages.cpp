@@ -117,7 +117,7 @@ PreparedInput prepare_input(const TriMesh& input, const SimplifyOptions& options
   return p;
 }
 
-// Quality and distance to the input, into the level's stats. Metro-style sampling of both
+// Quality, distance to the input and crossing face pairs, into the level's stats. Metro-style sampling of both
 // surfaces, then a uniform random subset of at most 50k points per surface: a marching-cubes
 // input has hundreds of thousands of faces, and 50k points estimate the RMS to well under 1 %
 // (the Hausdorff distance is the largest over the subset).
@@ -125,6 +125,9 @@ void measure_level(const TriMesh& original, const SurfaceLocator& locator, const
   nlohmann::json& s = level.stats;
   const TriMesh mesh{level.positions, F};
   s["quality"] = mesh_quality(mesh);
+  // Every vertex lies on the input, yet where the input is thinner than an edge the level's
+  // triangles can pass through one another: a fold the quality figures do not show.
+  s["self_intersections"] = count_self_intersections(mesh);
   DistanceOptions sampling;
   sampling.samples_per_face =
       std::clamp(static_cast<int>(5e5 / std::max(original.num_faces(), mesh.num_faces())), 1, 10);

@@ -76,7 +76,9 @@ std::shared_ptr<SurfaceLocator> map_beside_locator(const PreparedInput& input, b
 /// Moves every row of X to its closest point on the locator's surface.
 void reproject_onto(const SurfaceLocator& surface, RowMatrixX3d& X);
 
-/// Quality and distance to the original input, into level.stats.
+/// Quality, distance to the original input and self-intersecting face pairs
+/// (count_self_intersections), into level.stats.
+/// \throw TopologyError as count_self_intersections does (not on the levels remesh builds).
 void measure_level(const TriMesh& original, const SurfaceLocator& locator, const RowMatrixX3i& F, RemeshLevel& level);
 
 }  // namespace mrsnake::remesh_stages

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mesh/distance.h"
 #include "mesh/image_io.h"
 #include "tests/test_support.h"
 #include "model/model_io.h"
@@ -93,6 +94,10 @@ TEST(BuildModelCli, BuildsAModelThatModelInfoAccepts) {
   EXPECT_NEAR(center.y(), 30.0 + 17.5, 1.0);
   EXPECT_NEAR(center.z(), 5.0 + 15.5 * 1.25, 1.0);
   EXPECT_TRUE(m.remesh_quality.contains("finest_level_quality"));
+  // The finest level is checked for crossing faces: none on an ellipsoid, and no warning.
+  EXPECT_EQ(m.remesh_quality["finest_level_self_intersections"].get<int>(),
+            count_self_intersections(TriMesh{m.level_positions.back(), m.connectivity().faces.back()}));
+  EXPECT_EQ(summary["finest_level_self_intersections"].get<int>(), 0);
   // The structure's size and every default derived from it are in model.json. The ellipsoid's
   // equivalent radius over 60 is below its 1 mm voxels: the voxels' own surface, smoothed 20 times.
   const nlohmann::json& scale = m.scale;

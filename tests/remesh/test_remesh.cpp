@@ -552,14 +552,17 @@ TEST(RemeshCli, WritesNestedLevelsAndReport) {
   const auto report = nlohmann::json::parse(in);
   ASSERT_EQ(report["per_level"].size(), 3u);
   for (const auto& level : report["per_level"]) {
-    for (const char* key : {"vertices", "faces", "flipped_triangles", "seconds", "quality", "distance"})
+    for (const char* key :
+         {"vertices", "faces", "flipped_triangles", "self_intersections", "seconds", "quality", "distance"})
       EXPECT_TRUE(level.contains(key)) << key;
+    EXPECT_EQ(level["self_intersections"].get<int>(), 0);
     EXPECT_TRUE(level["quality"].contains("q_min"));
     EXPECT_TRUE(level["quality"].contains("pct_valence6_interior"));
     EXPECT_TRUE(level["distance"].contains("rms_pct"));
     EXPECT_TRUE(level["distance"].contains("hausdorff_pct"));
     EXPECT_EQ(level["flipped_triangles"].get<int>(), 0);
   }
+  EXPECT_EQ(r.output.find("passes through itself"), std::string::npos) << r.output;
   // A small input takes the punctured map by default; --sphere-map halves asks for the cut.
   EXPECT_FALSE(report["parameterization"].contains("cut_vertices"));
   const auto halves = test::run_mrsnake("-q remesh " + input + " -o " + (dir / "halves").string() +
@@ -583,6 +586,30 @@ TEST(RemeshCli, WritesNestedLevelsAndReport) {
             unfitted_report["per_level"][2]["distance"]["rms_pct"].get<double>());
   EXPECT_EQ(test::run_mrsnake("-q remesh " + input + " -o " + (dir / "bad").string() + " --fit-rounds -1").exit_code,
             2);
+  std::filesystem::remove_all(dir);
+}
+
+// The octopus's tentacle tips are thinner than the edges of a 1000-face level, whose vertices
+// all lie on the input: its triangles cross there. The count is recorded per level and the
+// finest level's is a warning, as the quality figures alone would not show it.
+TEST(RemeshCli, FlagsAFinestLevelThatPassesThroughItself) {
+  MRSNAKE_REQUIRE_DATA(octopus, "meshes/octopus.off");
+  const auto dir = test::scratch_dir("remesh-crossing");
+  const auto r = test::run_mrsnake("-q remesh " + octopus + " -o " + dir.string() + " --faces 1000");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(dir / "report.json");
+  const auto report = nlohmann::json::parse(in);
+  const auto& levels = report["per_level"];
+  for (std::size_t j = 0; j < levels.size(); ++j)
+    EXPECT_EQ(levels[j]["self_intersections"].get<int>(),
+              count_self_intersections(read_mesh((dir / ("level_" + std::to_string(j) + ".vtp")).string())))
+        << j;
+  const int finest = levels.back()["self_intersections"].get<int>();
+  ASSERT_GT(finest, 0) << "the octopus no longer folds at 1000 faces: take a harder input";
+  EXPECT_NE(
+      r.output.find("warning: the finest level passes through itself at " + std::to_string(finest) + " face pairs"),
+      std::string::npos)
+      << r.output;
   std::filesystem::remove_all(dir);
 }
 
