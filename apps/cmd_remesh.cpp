@@ -24,8 +24,8 @@ void warn_if_self_intersecting(const RemeshResult& result) {
   const int pairs = finest.value("self_intersections", 0);
   if (pairs > 0)
     warn("the finest level passes through itself at " + std::to_string(pairs) +
-         " face pairs (report.json per_level), where the input is thinner than its edges; more --faces make the edges "
-         "shorter");
+         " face pairs (report.json per_level); it folds where the input is thinner than its edges, and more --faces "
+         "make them shorter");
 }
 
 }  // namespace

@@ -117,10 +117,10 @@ PreparedInput prepare_input(const TriMesh& input, const SimplifyOptions& options
   return p;
 }
 
-// Quality, distance to the input and crossing face pairs, into the level's stats. Metro-style sampling of both
-// surfaces, then a uniform random subset of at most 50k points per surface: a marching-cubes
-// input has hundreds of thousands of faces, and 50k points estimate the RMS to well under 1 %
-// (the Hausdorff distance is the largest over the subset).
+// Quality, distance to the input and crossing face pairs, into the level's stats. Metro-style
+// sampling of both surfaces, then a uniform random subset of at most 50k points per surface:
+// a marching-cubes input has hundreds of thousands of faces, and 50k points estimate the RMS
+// to well under 1 % (the Hausdorff distance is the largest over the subset).
 void measure_level(const TriMesh& original, const SurfaceLocator& locator, const RowMatrixX3i& F, RemeshLevel& level) {
   nlohmann::json& s = level.stats;
   const TriMesh mesh{level.positions, F};
