@@ -115,7 +115,7 @@ void warn_about(const BuiltModel& built, const BuildModelOptions& o, int value) 
   if (built.self_intersections > 0)
     warn("label " + std::to_string(value) + ": the model's finest level passes through itself at " +
          std::to_string(built.self_intersections) +
-         " face pairs; it folds where the surface is thinner than its edges, and more --faces make them shorter");
+         " face pairs (model.json remesh_quality): segmentations with it may fold there too");
   if (!(built.fit.dice >= kMinLabelFitDice))
     warn(describe_poor_fit(built.fit) +
          poor_fit_cause(built.scale, choices_of(o, built.mc_spacing_mm, s.closing_radius)));

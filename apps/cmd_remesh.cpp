@@ -18,14 +18,14 @@ namespace mrsnake::cli {
 
 namespace {
 
-// A finest level that passes through itself is flagged: its quality figures look fine.
+// A finest level that passes through itself is flagged: its quality figures look fine. The
+// cause varies (a tip thinner than an edge, a fold of the base mesh), and so does the cure.
 void warn_if_self_intersecting(const RemeshResult& result) {
   const nlohmann::json& finest = result.levels.back().stats;
   const int pairs = finest.value("self_intersections", 0);
   if (pairs > 0)
     warn("the finest level passes through itself at " + std::to_string(pairs) +
-         " face pairs (report.json per_level); it folds where the input is thinner than its edges, and more --faces "
-         "make them shorter");
+         " face pairs (report.json per_level): check it before use");
 }
 
 }  // namespace
