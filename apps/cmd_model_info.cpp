@@ -105,8 +105,9 @@ void print_structure_text(const std::string& model_path, const ShapeModel& model
     std::cout << "  remesh quality   ";
     for (const char* key : {"min_angle_deg", "q_min", "q_mean", "pct_valence6_interior", "edge_length_cv"})
       if (q.contains(key) && q[key].is_number()) std::cout << ' ' << key << ' ' << format("%.3g", q[key].get<double>());
-    if (const nlohmann::json& m = model.remesh_quality; m.contains("finest_level_self_intersections"))
-      std::cout << " self_intersections " << m["finest_level_self_intersections"].get<int>();
+    if (const nlohmann::json& m = model.remesh_quality;
+        m.contains("finest_level_self_intersections") && m["finest_level_self_intersections"].is_number_integer())
+      std::cout << " self_intersections " << m["finest_level_self_intersections"].get<long long>();
     std::cout << '\n';
   }
   if (model.scale.is_object()) {

@@ -125,8 +125,8 @@ void measure_level(const TriMesh& original, const SurfaceLocator& locator, const
   nlohmann::json& s = level.stats;
   const TriMesh mesh{level.positions, F};
   s["quality"] = mesh_quality(mesh);
-  // Every vertex lies on the input, yet where the input is thinner than an edge the level's
-  // triangles can pass through one another: a fold the quality figures do not show.
+  // Every vertex lies on the input, yet the level's triangles can pass through one another (a
+  // tip thinner than an edge, a fold of the base mesh): a fault the quality figures do not show.
   s["self_intersections"] = count_self_intersections(mesh);
   DistanceOptions sampling;
   sampling.samples_per_face =

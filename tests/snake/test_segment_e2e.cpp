@@ -417,7 +417,7 @@ TEST(SegmentReal, TheLateralVentriclesWithTheirHornsBuildAModelAndSegment) {
       << choice;
   std::printf("lateral ventricles: the %s domain kept (%s)\n", choice["chosen"].get<std::string>().c_str(),
               choice.dump().c_str());
-  // The horns are thicker than the model's edges: its finest level does not pass through itself.
+  // Nor does the model's finest level pass through itself (build-model counts its crossing faces).
   EXPECT_EQ(model["remesh_quality"]["finest_level_self_intersections"].get<int>(), 0);
   const auto c = mrsnake::test::run_mrsnake("-q synth --from-image " + image + " --from-labels " + labels +
                                             " --label 1 --pose random --deform 2 --seed 7 -o " + d + "/case");
