@@ -2,6 +2,13 @@
 # Eigen's config must be found before VTK, whose own FindEigen3 module would shadow it.
 find_package(Eigen3 3.4 REQUIRED NO_MODULE)
 find_package(CGAL REQUIRED)
+# SuiteSparse's KLU (libsuitesparse-dev, no CMake config in Debian's 5.12): the sparse LU of the
+# mean value parameterization, through Eigen's KLUSupport.
+find_path(KLU_INCLUDE_DIR klu.h PATH_SUFFIXES suitesparse REQUIRED)
+find_library(KLU_LIBRARY klu REQUIRED)
+add_library(SuiteSparse::KLU INTERFACE IMPORTED)
+set_target_properties(SuiteSparse::KLU PROPERTIES
+  INTERFACE_INCLUDE_DIRECTORIES "${KLU_INCLUDE_DIR}" INTERFACE_LINK_LIBRARIES "${KLU_LIBRARY}")
 find_package(VTK REQUIRED COMPONENTS
   CommonCore CommonDataModel CommonExecutionModel CommonTransforms
   FiltersCore FiltersGeneral FiltersModeling FiltersSources FiltersGeometry
