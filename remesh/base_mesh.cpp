@@ -203,64 +203,81 @@ int flip_toward_regular_valence(int n, RowMatrixX3i& F, int rim_min_triangles, c
   return flips;
 }
 
+namespace {
+
+// Farthest point samples of a disk: nb on its rim first, evenly spaced, then the interior.
+// `rim_edges` are the input's boundary edges (each appears once: their lengths sum to the
+// perimeter).
+void sample_disk(const TriMesh& mesh, int n0, const std::vector<std::pair<int, int>>& rim_edges,
+                 const std::vector<bool>& boundary, const Eigen::VectorXd* density, std::vector<double>& dist,
+                 std::vector<int>& samples) {
+  const int n = mesh.num_vertices();
+  std::vector<int> rim;
+  for (int v = 0; v < n; ++v)
+    if (boundary[v]) rim.push_back(v);
+  double area = 0, perimeter = 0;
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+    area += 0.5 * (b - a).cross(c - a).norm();
+  }
+  for (const auto& [a, b] : rim_edges) perimeter += (mesh.V.row(a) - mesh.V.row(b)).norm();
+  // Even spacing h over the whole disk: area ~ (n0 - nb/2)·(√3/2)·h², nb ~ perimeter / h.
+  double h = std::sqrt(2 * area / (std::sqrt(3.0) * n0));
+  for (int it = 0; it < 20; ++it) {
+    const double nb = perimeter / h;
+    h = std::sqrt(2 * area / (std::sqrt(3.0) * std::max(1.0, n0 - nb / 2)));
+  }
+  const int nb = std::clamp(static_cast<int>(std::lround(perimeter / h)), 3, std::max(3, n0 - 1));
+  // Start the rim sampling from the rim vertex farthest from the centroid.
+  const Eigen::RowVector3d centroid = mesh.V.colwise().mean();
+  int first = rim.front();
+  for (int v : rim)
+    if ((mesh.V.row(v) - centroid).squaredNorm() > (mesh.V.row(first) - centroid).squaredNorm()) first = v;
+  samples.push_back(first);
+  for (int v = 0; v < n; ++v) dist[v] = (mesh.V.row(v) - mesh.V.row(first)).squaredNorm();
+  farthest_points(mesh.V, rim, nb - 1, dist, samples);
+  std::vector<int> inner;
+  for (int v = 0; v < n; ++v)
+    if (!boundary[v]) inner.push_back(v);
+  farthest_points(mesh.V, inner, n0 - static_cast<int>(samples.size()), dist, samples, density);
+}
+
+// Farthest point samples of a closed surface, from the vertex farthest from the centroid.
+void sample_closed(const TriMesh& mesh, int n0, const Eigen::VectorXd* density, std::vector<double>& dist,
+                   std::vector<int>& samples) {
+  const int n = mesh.num_vertices();
+  const Eigen::RowVector3d centroid = mesh.V.colwise().mean();
+  std::vector<int> all(n);
+  for (int v = 0; v < n; ++v) all[v] = v;
+  int first = 0;
+  for (int v = 0; v < n; ++v)
+    if ((mesh.V.row(v) - centroid).squaredNorm() > (mesh.V.row(first) - centroid).squaredNorm()) first = v;
+  samples.push_back(first);
+  for (int v = 0; v < n; ++v) dist[v] = (mesh.V.row(v) - mesh.V.row(first)).squaredNorm();
+  farthest_points(mesh.V, all, n0 - 1, dist, samples, density);
+}
+
+}  // namespace
+
 BaseMesh build_base_mesh(const Parameterization& param, int n0, int rim_min_triangles, const Eigen::VectorXd* density) {
   const TriMesh& mesh = param.surface;
   const int n = mesh.num_vertices();
   n0 = std::min(n0, n);
   BaseMesh base;
   std::vector<double> dist(n, std::numeric_limits<double>::infinity());
-  std::vector<int> all(n);
-  for (int v = 0; v < n; ++v) all[v] = v;
-  const Eigen::RowVector3d centroid = mesh.V.colwise().mean();
-
+  std::vector<bool> input_boundary(n, false);
   if (param.kind == DomainKind::disk) {
-    const std::vector<bool> boundary = boundary_vertices(mesh.F, n);
-    std::vector<int> rim;
-    for (int v = 0; v < n; ++v)
-      if (boundary[v]) rim.push_back(v);
-    double area = 0, perimeter = 0;
-    for (int f = 0; f < mesh.num_faces(); ++f) {
-      const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
-      area += 0.5 * (b - a).cross(c - a).norm();
-    }
-    // Boundary edges appear once; their total length is the perimeter.
-    std::map<std::pair<int, int>, int> directed;
-    for (int f = 0; f < mesh.num_faces(); ++f)
-      for (int k = 0; k < 3; ++k) directed[{mesh.F(f, k), mesh.F(f, (k + 1) % 3)}] = f;
-    for (const auto& [e, f] : directed)
-      if (!directed.count({e.second, e.first})) perimeter += (mesh.V.row(e.first) - mesh.V.row(e.second)).norm();
-    // Even spacing h over the whole disk: area ~ (n0 - nb/2)·(√3/2)·h², nb ~ perimeter / h.
-    double h = std::sqrt(2 * area / (std::sqrt(3.0) * n0));
-    for (int it = 0; it < 20; ++it) {
-      const double nb = perimeter / h;
-      h = std::sqrt(2 * area / (std::sqrt(3.0) * std::max(1.0, n0 - nb / 2)));
-    }
-    const int nb = std::clamp(static_cast<int>(std::lround(perimeter / h)), 3, std::max(3, n0 - 1));
-    // Start the rim sampling from the rim vertex farthest from the centroid.
-    int first = rim.front();
-    for (int v : rim)
-      if ((mesh.V.row(v) - centroid).squaredNorm() > (mesh.V.row(first) - centroid).squaredNorm()) first = v;
-    base.samples.push_back(first);
-    for (int v = 0; v < n; ++v) dist[v] = (mesh.V.row(v) - mesh.V.row(first)).squaredNorm();
-    farthest_points(mesh.V, rim, nb - 1, dist, base.samples);
-    std::vector<int> inner;
-    for (int v = 0; v < n; ++v)
-      if (!boundary[v]) inner.push_back(v);
-    farthest_points(mesh.V, inner, n0 - static_cast<int>(base.samples.size()), dist, base.samples, density);
+    // One pass over the input's stars gives the rim, its length and the boundary flags.
+    const std::vector<std::pair<int, int>> rim_edges = boundary_edges(mesh.F, VertexStars(mesh.F, n));
+    for (const auto& [a, b] : rim_edges) input_boundary[a] = input_boundary[b] = true;
+    sample_disk(mesh, n0, rim_edges, input_boundary, density, dist, base.samples);
   } else {
-    int first = 0;
-    for (int v = 0; v < n; ++v)
-      if ((mesh.V.row(v) - centroid).squaredNorm() > (mesh.V.row(first) - centroid).squaredNorm()) first = v;
-    base.samples.push_back(first);
-    for (int v = 0; v < n; ++v) dist[v] = (mesh.V.row(v) - mesh.V.row(first)).squaredNorm();
-    farthest_points(mesh.V, all, n0 - 1, dist, base.samples, density);
+    sample_closed(mesh, n0, density, dist, base.samples);
   }
 
   // Triangulates the samples in D, then flips toward regular valences. With a disk, a rim
   // sample left with fewer than rim_min_triangles triangles is dropped and the rest
   // triangulated again: with 2, its corners stay obtuse (~120 degrees in 3D) at every level.
-  const std::vector<bool> input_boundary =
-      param.kind == DomainKind::disk ? boundary_vertices(mesh.F, n) : std::vector<bool>(n, false);
   for (int attempt = 0;; ++attempt) {
     triangulate_samples(param, input_boundary, rim_min_triangles, base);
     if (param.kind != DomainKind::disk || attempt == 4) break;
