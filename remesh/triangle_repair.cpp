@@ -51,10 +51,13 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
   std::vector<std::pair<double, int>> poor;
   std::vector<int> visited(n, -1);
   RepairRetries retries(F, stars, n);
+  // Each face's quality, kept current as vertices move: a sweep's scan reads it.
+  std::vector<double> face_quality(m);
+  for (int f = 0; f < m; ++f) face_quality[f] = quality(f, -1, Eigen::Vector3d::Zero());
   for (int sweep = 0; sweep < options.sweeps; ++sweep) {
     poor.clear();
     for (int f = 0; f < m; ++f)
-      if (const double q = quality(f, -1, Eigen::Vector3d::Zero()); q < options.threshold) poor.emplace_back(q, f);
+      if (face_quality[f] < options.threshold) poor.emplace_back(face_quality[f], f);
     if (poor.empty()) break;
     std::sort(poor.begin(), poor.end());
     int moved = 0;
@@ -108,6 +111,8 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
         U.row(v) = best_u.transpose();
         X.row(v) = best_x.transpose();
         hints[v] = best_hint;
+        for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i)
+          face_quality[stars.faces[i]] = quality(stars.faces[i], -1, Eigen::Vector3d::Zero());
         retries.moved(v);
         ++moved;
       }
