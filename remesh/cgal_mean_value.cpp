@@ -34,7 +34,8 @@ using BaseTraits = CGAL::Eigen_solver_traits<Eigen::SparseLU<EigenMatrix, Eigen:
 // looking for the blocks costs time.
 struct KLUTraits : BaseTraits {
   const Matrix* factored = nullptr;
-  std::shared_ptr<Eigen::KLU<EigenMatrix>> lu = std::make_shared<Eigen::KLU<EigenMatrix>>();  // traits are copied by CGAL
+  // Shared: CGAL copies the traits.
+  std::shared_ptr<Eigen::KLU<EigenMatrix>> lu = std::make_shared<Eigen::KLU<EigenMatrix>>();
   bool linear_solver(const Matrix& A, const Vector& B, Vector& X, NT& D) {
     if (factored != &A) {
       lu->kluCommon().btf = 0;
