@@ -150,6 +150,25 @@ TEST(BuildModelCli, BuildsAModelThatModelInfoAccepts) {
             read_all(std::filesystem::path(halves) / "details.bin"));
 }
 
+// The mouse ventricles (label 10 of mouse 1) are thin sheets, and their model's finest level
+// crosses itself with every default: the count is recorded, recounted equal, and warned of by name.
+TEST(BuildModelCli, FlagsAModelWhoseFinestLevelPassesThroughItself) {
+  MRSNAKE_REQUIRE_DATA(labels, "volumes/mouse-brain/mouse1_labels.nii.gz");
+  const auto dir = scratch_dir("build-model-crossing");
+  const std::string model = (dir / "ventricles.model").string();
+  const auto built = run_mrsnake("-q build-model --labels " + labels + " --label 10 -o " + model);
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  const ShapeModel m = load_model_set(model, {true}).structures.at(0).model;
+  const int crossings = m.remesh_quality["finest_level_self_intersections"].get<int>();
+  EXPECT_EQ(crossings, count_self_intersections(TriMesh{m.level_positions.back(), m.connectivity().faces.back()}));
+  ASSERT_GT(crossings, 0) << "the mouse ventricles' model no longer folds: take a harder input";
+  EXPECT_NE(built.output.find("warning: label 10: the model's finest level passes through itself at " +
+                              std::to_string(crossings) + " face pairs (model.json remesh_quality)"),
+            std::string::npos)
+      << built.output;
+  std::filesystem::remove_all(dir);
+}
+
 TEST(BuildModelCli, McSpacingZeroUsesTheVoxelSurface) {
   const auto dir = scratch_dir("build-model-cli-spacing");
   const std::string labels = write_ellipsoid_labels(dir);
