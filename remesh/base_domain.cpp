@@ -173,9 +173,9 @@ bool BaseDomain::in_star(int v, const BasePoint& p) const {
   return star_slot(v, p, bary) >= 0;
 }
 
-std::vector<int> BaseDomain::charts_holding(const BasePoint& p) const {
+BaseDomain::ChartList BaseDomain::charts_holding(const BasePoint& p) const {
   const RowMatrixX3i& F = base_.F;
-  std::vector<int> charts(F.row(p.face).data(), F.row(p.face).data() + 3);
+  ChartList charts(F.row(p.face).data(), F.row(p.face).data() + 3);
   int heaviest = 0;
   p.bary.maxCoeff(&heaviest);
   if (p.bary.minCoeff() > kOnSimplex) return charts;

@@ -132,7 +132,7 @@ void BaseLift::search_chart(int v, const Eigen::Vector2d& q, bool all, Hit& hit,
 BaseLift::Hit BaseLift::locate(const BasePoint& p) const {
   Hit hit;
   double best_min = -std::numeric_limits<double>::infinity();
-  const std::vector<int> charts = domain_->charts_holding(p);
+  const BaseDomain::ChartList charts = domain_->charts_holding(p);
   // The grid cell of p in each chart; only when those are all empty, every triangle of them.
   for (int pass = 0; pass < 2; ++pass) {
     for (int v : charts) {

@@ -186,7 +186,7 @@ TEST(BaseDomain, APointOnASharedEdgeHasOneChartPosition) {
         for (int j = 0; j < 3; ++j) in_g[j] = base.F(g, j) == a ? 0.3 : base.F(g, j) == b ? 0.7 : 0.0;
         const BasePoint p = at(f, in_f), q = at(g, in_g);
         EXPECT_LT((domain.position(p) - domain.position(q)).norm(), 1e-15);
-        const std::vector<int> charts = domain.charts_holding(p);
+        const BaseDomain::ChartList charts = domain.charts_holding(p);
         EXPECT_EQ(charts.size(), 4u);
         for (int v : charts) EXPECT_LT((domain.to_chart(v, p) - domain.to_chart(v, q)).norm(), 1e-14);
       }
