@@ -11,133 +11,201 @@
 
 namespace mrsnake {
 
+namespace {
+
+// Where the input vertices stand against the level before any snap: each one's nearest level
+// face and its distance, and per level face the input vertices nearest to it (so that a snap
+// can be judged on the input around it).
+struct InputAgainstLevel {
+  std::vector<int> nearest_face;
+  std::vector<double> distance;
+  std::vector<int> under_offset, under;  ///< face f's input vertices: under[under_offset[f] ..]
+  double largest = 0;
+};
+
+InputAgainstLevel measure_input_against_level(const RowMatrixX3d& X, const RowMatrixX3i& F,
+                                              const RowMatrixX3d& surface_V) {
+  const int m = static_cast<int>(F.rows());
+  const int input_vertices = static_cast<int>(surface_V.rows());
+  InputAgainstLevel input;
+  input.nearest_face.resize(input_vertices);
+  input.distance.resize(input_vertices);
+  const SurfaceLocator level(TriMesh{X, F});
+  // Every input vertex is queried (90k on a liver): both cores.
+  parallel_ranges(static_cast<std::size_t>(input_vertices), [&](std::size_t begin, std::size_t end) {
+    for (auto s = static_cast<int>(begin); s < static_cast<int>(end); ++s) {
+      const SurfaceLocator::Hit hit = level.closest(surface_V.row(s).transpose());
+      input.nearest_face[s] = hit.face;
+      input.distance[s] = hit.distance;
+    }
+  });
+  input.under_offset.assign(m + 1, 0);
+  for (int s = 0; s < input_vertices; ++s) ++input.under_offset[input.nearest_face[s] + 1];
+  for (int f = 0; f < m; ++f) input.under_offset[f + 1] += input.under_offset[f];
+  input.under.resize(input.under_offset[m]);
+  std::vector<int> fill(input.under_offset.begin(), input.under_offset.end() - 1);
+  for (int s = 0; s < input_vertices; ++s) input.under[fill[input.nearest_face[s]]++] = s;
+  input.largest = *std::max_element(input.distance.begin(), input.distance.end());
+  return input;
+}
+
+// The input vertices to try as tips, farthest first: beyond far_threshold, on a face of the
+// input, and not on its rim.
+std::vector<int> far_tips(const InputAgainstLevel& input, double far_threshold, const RowMatrixX3i& input_F,
+                          const std::vector<bool>& input_rim) {
+  std::vector<bool> on_a_face(input.distance.size(), false);
+  for (int f = 0; f < input_F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) on_a_face[input_F(f, k)] = true;
+  std::vector<int> far;
+  for (int s = 0; s < static_cast<int>(input.distance.size()); ++s)
+    if (input.distance[s] > far_threshold && on_a_face[s] && !input_rim[s]) far.push_back(s);
+  const std::vector<double>& d = input.distance;
+  std::sort(far.begin(), far.end(), [&](int a, int b) { return d[a] > d[b] || (d[a] == d[b] && a < b); });
+  return far;
+}
+
+// Smallest angle (degrees) of v's triangles with v at x.
+double star_smallest_angle(const RowMatrixX3d& X, const RowMatrixX3i& F, const VertexStars& stars, int v,
+                           const Eigen::Vector3d& x) {
+  double smallest = 180;
+  for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
+    const int f = stars.faces[i];
+    Eigen::Vector3d P[3] = {X.row(F(f, 0)), X.row(F(f, 1)), X.row(F(f, 2))};
+    for (int k = 0; k < 3; ++k)
+      if (F(f, k) == v) P[k] = x;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d a = P[(k + 1) % 3] - P[k], b = P[(k + 2) % 3] - P[k];
+      smallest = std::min(smallest, std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI);
+    }
+  }
+  return smallest;
+}
+
+// The level vertex nearest to the point p: the closest corner of `face`.
+int nearest_corner(const RowMatrixX3d& X, const RowMatrixX3i& F, int face, const Eigen::Vector3d& p) {
+  int v = -1;
+  double best = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    const int w = F(face, k);
+    if (const double d = (X.row(w).transpose() - p).squaredNorm(); d < best) {
+      best = d;
+      v = w;
+    }
+  }
+  return v;
+}
+
+// The faces of v's star and of its neighbours' stars: the triangles a move of v can change the
+// nearest point on, for the input near v. Reads X as it is when asked (earlier snaps included).
+class SnapRegion {
+ public:
+  SnapRegion(const RowMatrixX3d& X, const RowMatrixX3i& F, const VertexStars& stars, const InputAgainstLevel& input,
+             const RowMatrixX3d& surface_V)
+      : X_(X), F_(F), stars_(stars), input_(input), surface_V_(surface_V), mark_(F.rows(), -1) {}
+
+  void collect(int v) {
+    faces_.clear();
+    ++stamp_;
+    for (int i = stars_.offset[v]; i < stars_.offset[v + 1]; ++i)
+      for (int k = 0; k < 3; ++k) {
+        const int w = F_(stars_.faces[i], k);
+        for (int j = stars_.offset[w]; j < stars_.offset[w + 1]; ++j) {
+          const int f = stars_.faces[j];
+          if (mark_[f] == stamp_) continue;
+          mark_[f] = stamp_;
+          faces_.push_back(f);
+        }
+      }
+  }
+
+  // Distance from p to the region's triangles with v at x.
+  double distance(const Eigen::Vector3d& p, int v, const Eigen::Vector3d& x) const {
+    double d = std::numeric_limits<double>::infinity();
+    for (int f : faces_) {
+      Eigen::Vector3d P[3] = {X_.row(F_(f, 0)), X_.row(F_(f, 1)), X_.row(F_(f, 2))};
+      for (int k = 0; k < 3; ++k)
+        if (F_(f, k) == v) P[k] = x;
+      d = std::min(d, point_triangle_distance(p, P[0], P[1], P[2]));
+    }
+    return d;
+  }
+
+  // The largest distance from the input vertices under the region to its triangles, v at x.
+  double error(int v, const Eigen::Vector3d& x) const {
+    double error = 0;
+    for (int f : faces_)
+      for (int i = input_.under_offset[f]; i < input_.under_offset[f + 1]; ++i)
+        error = std::max(error, distance(surface_V_.row(input_.under[i]).transpose(), v, x));
+    return error;
+  }
+
+ private:
+  const RowMatrixX3d& X_;
+  const RowMatrixX3i& F_;
+  const VertexStars& stars_;
+  const InputAgainstLevel& input_;
+  const RowMatrixX3d& surface_V_;
+  std::vector<int> faces_, mark_;
+  int stamp_ = 0;
+};
+
+// Whether the largest input-to-level distance, with the `moved` vertices snapped, is at most
+// `limit`: the same decision as querying the whole input, up to rounding, without querying it
+// all again. An input vertex whose nearest face did not change is at most as far as before
+// (that face is still there), so only those nearest to a changed face and those that were
+// already beyond the limit can be beyond it now.
+bool largest_distance_within(const RowMatrixX3d& X, const RowMatrixX3i& F, const VertexStars& stars,
+                             const std::vector<bool>& moved, const InputAgainstLevel& input,
+                             const RowMatrixX3d& surface_V, double limit) {
+  std::vector<bool> changed(F.rows(), false);
+  for (int v = 0; v < static_cast<int>(moved.size()); ++v)
+    if (moved[v])
+      for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) changed[stars.faces[i]] = true;
+  std::vector<int> recheck;
+  for (int s = 0; s < static_cast<int>(input.distance.size()); ++s)
+    if (changed[input.nearest_face[s]] || input.distance[s] > limit) recheck.push_back(s);
+  if (recheck.empty()) return true;
+  RowMatrixX3d points(static_cast<Eigen::Index>(recheck.size()), 3);
+  for (std::size_t i = 0; i < recheck.size(); ++i) points.row(static_cast<Eigen::Index>(i)) = surface_V.row(recheck[i]);
+  return SurfaceLocator(TriMesh{X, F}).distances(points).maxCoeff() <= limit;
+}
+
+}  // namespace
+
 int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMatrixX3d& surface_V,
                              const RowMatrixX3i& input_F, const std::vector<bool>& rim,
                              const std::vector<bool>& input_rim, const SnapInDomain& domain,
                              const FeatureSnapOptions& options, std::vector<bool>* snapped) {
   const int n = static_cast<int>(X.rows());
-  const int m = static_cast<int>(F.rows());
   if (snapped) snapped->assign(n, false);
-  if (m == 0 || options.max_snaps <= 0) return 0;
+  if (F.rows() == 0 || options.max_snaps <= 0) return 0;
   const VertexStars stars(F, n);
-  const int input_vertices = static_cast<int>(surface_V.rows());
-  std::vector<int> face_of(input_vertices, -1);  // one face of the input around each of its vertices
-  for (int f = 0; f < input_F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) face_of[input_F(f, k)] = f;
   const double threshold = options.min_distance * mean_edge_length(X, F);
+  const InputAgainstLevel input = measure_input_against_level(X, F, surface_V);
+  const double far_threshold = std::max(threshold, options.min_share_of_largest * input.largest);
 
-  // The level face nearest to each input vertex, before any snap; the input vertices under
-  // each level face (so that a snap can be judged on the input around it).
-  const SurfaceLocator level(TriMesh{X, F});
-  std::vector<int> nearest_face(input_vertices);
-  std::vector<double> distance(input_vertices);
-  // Every input vertex is queried (90k on a liver): both cores.
-  parallel_ranges(static_cast<std::size_t>(input_vertices), [&](std::size_t begin, std::size_t end) {
-    for (auto s = static_cast<int>(begin); s < static_cast<int>(end); ++s) {
-      const SurfaceLocator::Hit hit = level.closest(surface_V.row(s).transpose());
-      nearest_face[s] = hit.face;
-      distance[s] = hit.distance;
-    }
-  });
-  std::vector<int> under_offset(m + 1, 0), under;
-  for (int s = 0; s < input_vertices; ++s) ++under_offset[nearest_face[s] + 1];
-  for (int f = 0; f < m; ++f) under_offset[f + 1] += under_offset[f];
-  under.resize(under_offset[m]);
-  {
-    std::vector<int> fill(under_offset.begin(), under_offset.end() - 1);
-    for (int s = 0; s < input_vertices; ++s) under[fill[nearest_face[s]]++] = s;
-  }
-  const double largest = *std::max_element(distance.begin(), distance.end());
-  const double far_threshold = std::max(threshold, options.min_share_of_largest * largest);
-  std::vector<int> far;
-  for (int s = 0; s < input_vertices; ++s)
-    if (distance[s] > far_threshold && face_of[s] >= 0 && !input_rim[s]) far.push_back(s);
-  std::sort(far.begin(), far.end(),
-            [&](int a, int b) { return distance[a] > distance[b] || (distance[a] == distance[b] && a < b); });
-
-  // The faces of v's star and of its neighbours' stars: the triangles a move of v can change
-  // the nearest point on, for the input near v.
-  std::vector<int> region, region_mark(m, -1);
-  int stamp = 0;
-  auto collect_region = [&](int v) {
-    region.clear();
-    ++stamp;
-    for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i)
-      for (int k = 0; k < 3; ++k) {
-        const int w = F(stars.faces[i], k);
-        for (int j = stars.offset[w]; j < stars.offset[w + 1]; ++j) {
-          const int f = stars.faces[j];
-          if (region_mark[f] == stamp) continue;
-          region_mark[f] = stamp;
-          region.push_back(f);
-        }
-      }
-  };
-  // Distance from p to the region's triangles with v at x.
-  auto region_distance = [&](const Eigen::Vector3d& p, int v, const Eigen::Vector3d& x) {
-    double d = std::numeric_limits<double>::infinity();
-    for (int f : region) {
-      Eigen::Vector3d P[3] = {X.row(F(f, 0)), X.row(F(f, 1)), X.row(F(f, 2))};
-      for (int k = 0; k < 3; ++k)
-        if (F(f, k) == v) P[k] = x;
-      d = std::min(d, point_triangle_distance(p, P[0], P[1], P[2]));
-    }
-    return d;
-  };
-  // The largest distance from the input vertices under the region to its triangles, v at x.
-  auto region_error = [&](int v, const Eigen::Vector3d& x) {
-    double error = 0;
-    for (int f : region)
-      for (int i = under_offset[f]; i < under_offset[f + 1]; ++i)
-        error = std::max(error, region_distance(surface_V.row(under[i]).transpose(), v, x));
-    return error;
-  };
-  // Smallest angle (degrees) of v's triangles with v at x.
-  auto star_angle = [&](int v, const Eigen::Vector3d& x) {
-    double smallest = 180;
-    for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
-      const int f = stars.faces[i];
-      Eigen::Vector3d P[3] = {X.row(F(f, 0)), X.row(F(f, 1)), X.row(F(f, 2))};
-      for (int k = 0; k < 3; ++k)
-        if (F(f, k) == v) P[k] = x;
-      for (int k = 0; k < 3; ++k) {
-        const Eigen::Vector3d a = P[(k + 1) % 3] - P[k], b = P[(k + 2) % 3] - P[k];
-        smallest = std::min(smallest, std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI);
-      }
-    }
-    return smallest;
-  };
+  SnapRegion region(X, F, stars, input, surface_V);
   std::vector<bool> moved(n, false);
   const RowMatrixX3d X_before = X;
   int snaps = 0, judged = 0;
   const int max_judged = 8 * options.max_snaps;  // the region error is the costly part
-  for (int s : far) {
+  for (int s : far_tips(input, far_threshold, input_F, input_rim)) {
     if (snaps >= options.max_snaps || judged >= max_judged) break;
-    // The level vertex nearest the tip: the closest corner of the level face nearest to it.
-    const int face = nearest_face[s];
-    int v = -1;
-    double best = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < 3; ++k) {
-      const int w = F(face, k);
-      const double d = (X.row(w) - surface_V.row(s)).squaredNorm();
-      if (d < best) {
-        best = d;
-        v = w;
-      }
-    }
-    if (v < 0 || moved[v] || rim[v]) continue;
     const Eigen::Vector3d x = surface_V.row(s).transpose();
+    const int v = nearest_corner(X, F, input.nearest_face[s], x);
+    if (v < 0 || moved[v] || rim[v]) continue;
     const Eigen::Vector3d x_old = X.row(v).transpose();
-    collect_region(v);
+    region.collect(v);
     // An earlier snap nearby may have fixed this tip already: its distance now, not before.
-    if (!(region_distance(x, v, x_old) > threshold)) continue;
+    if (!(region.distance(x, v, x_old) > threshold)) continue;
     if (!domain.allowed(v, s)) continue;
-    if (star_quality(X, F, stars, v, x) < options.min_quality || star_angle(v, x) < options.min_angle_deg) continue;
+    if (star_quality(X, F, stars, v, x) < options.min_quality ||
+        star_smallest_angle(X, F, stars, v, x) < options.min_angle_deg)
+      continue;
     // Worth it only if the input around v ends up really closer to the level: moving v onto s
     // also moves its triangles away from the input v stood on.
     ++judged;
-    const double before = region_error(v, x_old), after = region_error(v, x);
-    if (!(after <= (1 - options.min_gain) * before)) continue;
+    if (!(region.error(v, x) <= (1 - options.min_gain) * region.error(v, x_old))) continue;
     domain.apply(v, s);
     X.row(v) = x.transpose();
     moved[v] = true;
@@ -145,30 +213,11 @@ int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMa
   }
   // The snaps cost triangle quality: keep them only if they really bring the input closer
   // overall (the largest distance drops), not only around each snapped vertex.
-  if (snaps > 0) {
-    // "The largest distance after <= limit" (the same decision as querying the whole input,
-    // up to rounding), without querying the whole input again:
-    // an input vertex whose nearest face did not change is at most as far as before (that
-    // face is still there), so only those nearest to a changed face and those that were
-    // already beyond the limit can be beyond it now.
-    const double limit = (1 - options.min_gain) * largest;
-    std::vector<bool> changed(m, false);
-    for (int v = 0; v < n; ++v)
-      if (moved[v])
-        for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) changed[stars.faces[i]] = true;
-    std::vector<int> recheck;
-    for (int s = 0; s < input_vertices; ++s)
-      if (changed[nearest_face[s]] || distance[s] > limit) recheck.push_back(s);
-    RowMatrixX3d points(static_cast<Eigen::Index>(recheck.size()), 3);
-    for (std::size_t i = 0; i < recheck.size(); ++i)
-      points.row(static_cast<Eigen::Index>(i)) = surface_V.row(recheck[i]);
-    const double largest_after = recheck.empty() ? 0.0 : SurfaceLocator(TriMesh{X, F}).distances(points).maxCoeff();
-    if (!(largest_after <= limit)) {
-      X = X_before;
-      domain.undo();
-      if (snapped) snapped->assign(n, false);
-      return 0;
-    }
+  if (snaps > 0 &&
+      !largest_distance_within(X, F, stars, moved, input, surface_V, (1 - options.min_gain) * input.largest)) {
+    X = X_before;
+    domain.undo();
+    return 0;
   }
   if (snapped) *snapped = moved;
   return snaps;
