@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <set>
 
 #include "mesh/errors.h"
@@ -205,6 +206,18 @@ int flip_toward_regular_valence(int n, RowMatrixX3i& F, int rim_min_triangles, c
 
 namespace {
 
+// Starts farthest point sampling at the candidate farthest from the centroid (the first such
+// candidate on ties): the first sample, and every vertex's squared distance to it in `dist`.
+void start_at_farthest_from_centroid(const RowMatrixX3d& X, const std::vector<int>& candidates,
+                                     std::vector<double>& dist, std::vector<int>& samples) {
+  const Eigen::RowVector3d centroid = X.colwise().mean();
+  int first = candidates.front();
+  for (int v : candidates)
+    if ((X.row(v) - centroid).squaredNorm() > (X.row(first) - centroid).squaredNorm()) first = v;
+  samples.push_back(first);
+  for (int v = 0; v < X.rows(); ++v) dist[v] = (X.row(v) - X.row(first)).squaredNorm();
+}
+
 // Farthest point samples of a disk: nb on its rim first, evenly spaced, then the interior.
 // `rim_edges` are the input's boundary edges (each appears once: their lengths sum to the
 // perimeter).
@@ -228,13 +241,7 @@ void sample_disk(const TriMesh& mesh, int n0, const std::vector<std::pair<int, i
     h = std::sqrt(2 * area / (std::sqrt(3.0) * std::max(1.0, n0 - nb / 2)));
   }
   const int nb = std::clamp(static_cast<int>(std::lround(perimeter / h)), 3, std::max(3, n0 - 1));
-  // Start the rim sampling from the rim vertex farthest from the centroid.
-  const Eigen::RowVector3d centroid = mesh.V.colwise().mean();
-  int first = rim.front();
-  for (int v : rim)
-    if ((mesh.V.row(v) - centroid).squaredNorm() > (mesh.V.row(first) - centroid).squaredNorm()) first = v;
-  samples.push_back(first);
-  for (int v = 0; v < n; ++v) dist[v] = (mesh.V.row(v) - mesh.V.row(first)).squaredNorm();
+  start_at_farthest_from_centroid(mesh.V, rim, dist, samples);
   farthest_points(mesh.V, rim, nb - 1, dist, samples);
   std::vector<int> inner;
   for (int v = 0; v < n; ++v)
@@ -245,15 +252,9 @@ void sample_disk(const TriMesh& mesh, int n0, const std::vector<std::pair<int, i
 // Farthest point samples of a closed surface, from the vertex farthest from the centroid.
 void sample_closed(const TriMesh& mesh, int n0, const Eigen::VectorXd* density, std::vector<double>& dist,
                    std::vector<int>& samples) {
-  const int n = mesh.num_vertices();
-  const Eigen::RowVector3d centroid = mesh.V.colwise().mean();
-  std::vector<int> all(n);
-  for (int v = 0; v < n; ++v) all[v] = v;
-  int first = 0;
-  for (int v = 0; v < n; ++v)
-    if ((mesh.V.row(v) - centroid).squaredNorm() > (mesh.V.row(first) - centroid).squaredNorm()) first = v;
-  samples.push_back(first);
-  for (int v = 0; v < n; ++v) dist[v] = (mesh.V.row(v) - mesh.V.row(first)).squaredNorm();
+  std::vector<int> all(mesh.num_vertices());
+  std::iota(all.begin(), all.end(), 0);
+  start_at_farthest_from_centroid(mesh.V, all, dist, samples);
   farthest_points(mesh.V, all, n0 - 1, dist, samples, density);
 }
 

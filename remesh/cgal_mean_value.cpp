@@ -27,11 +27,11 @@ using EigenMatrix = CGAL::Eigen_sparse_matrix<double>::EigenType;
 using BaseTraits = CGAL::Eigen_solver_traits<Eigen::SparseLU<EigenMatrix, Eigen::COLAMDOrdering<int>>>;
 
 // CGAL solves the same matrix for u and for v: factor it once, with SuiteSparse's KLU. A mean
-// value matrix is an M-matrix (positive weights, rows summing to zero), so the diagonal stays
-// the pivot and the factorization is driven by the fill of KLU's AMD ordering of A + Aᵀ. On a
-// 31k-vertex disk it takes 0.15 s, where Eigen's SparseLU with the same AMD ordering took 0.28 s.
-// KLU's block triangular form is off: a connected mesh's matrix is one irreducible block, and
-// looking for the blocks costs time.
+// value matrix is an M-matrix (an interior row's positive weights sum to its diagonal, a border
+// row is the identity's), so the diagonal stays the pivot and the factorization is driven by the fill of KLU's AMD
+// ordering of A + Aᵀ. On a 31k-vertex disk it takes 0.15 s, where Eigen's SparseLU with the same AMD ordering took 0.28
+// s. KLU's block triangular form is off: a connected mesh's matrix is one irreducible block, and looking for the blocks
+// costs time.
 struct KLUTraits : BaseTraits {
   const Matrix* factored = nullptr;
   // Shared: CGAL copies the traits.

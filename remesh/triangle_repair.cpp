@@ -46,14 +46,18 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
   };
   const double mean_edge = mean_edge_length(X, F);
 
+  // Each face's quality, kept current as vertices move: the sweeps' scans and the smallest
+  // quality before and after read it.
+  std::vector<double> face_quality(m);
+  auto update_quality = [&](int f) { face_quality[f] = quality(f, -1, Eigen::Vector3d::Zero()); };
+  auto smallest = [&] { return m > 0 ? *std::min_element(face_quality.begin(), face_quality.end()) : 0.0; };
+  for (int f = 0; f < m; ++f) update_quality(f);
+
   TriangleRepairStats stats;
-  stats.q_min_before = smallest_quality(X, F);
+  stats.q_min_before = smallest();
   std::vector<std::pair<double, int>> poor;
   std::vector<int> visited(n, -1);
   RepairRetries retries(F, stars, n);
-  // Each face's quality, kept current as vertices move: a sweep's scan reads it.
-  std::vector<double> face_quality(m);
-  for (int f = 0; f < m; ++f) face_quality[f] = quality(f, -1, Eigen::Vector3d::Zero());
   for (int sweep = 0; sweep < options.sweeps; ++sweep) {
     poor.clear();
     for (int f = 0; f < m; ++f)
@@ -111,15 +115,14 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
         U.row(v) = best_u.transpose();
         X.row(v) = best_x.transpose();
         hints[v] = best_hint;
-        for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i)
-          face_quality[stars.faces[i]] = quality(stars.faces[i], -1, Eigen::Vector3d::Zero());
+        for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) update_quality(stars.faces[i]);
         retries.moved(v);
         ++moved;
       }
     stats.moves += moved;
     if (moved == 0) break;
   }
-  stats.q_min_after = smallest_quality(X, F);
+  stats.q_min_after = smallest();
   return stats;
 }
 
