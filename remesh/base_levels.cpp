@@ -10,6 +10,7 @@
 #include <utility>
 
 #include <Eigen/Dense>
+#include <boost/container/small_vector.hpp>
 
 #include "mesh/errors.h"
 #include "mesh/quality.h"
@@ -245,6 +246,15 @@ double surface_error_on_base(const RowMatrixX3i& F, const VertexStars& stars, co
   });
 }
 
+// A move of the repair: v at chart point `chart` (the base point `point`), lifted to x; q is its
+// star's smallest quality.
+struct RepairCandidate {
+  double q;
+  Eigen::Vector2d chart;
+  BasePoint point;
+  Eigen::Vector3d x;
+};
+
 // Vertex v of a poor triangle to the candidate (repair_targets() at full, half and quarter
 // steps) that raises the smallest Q of its triangles the most, if one does without adding a
 // flip in D and within the guard. Returns whether it moved.
@@ -260,11 +270,9 @@ bool repair_vertex(const RowMatrixX3i& F, const VertexStars& stars, const BaseDo
   const int c = domain.common_chart(points.data(), static_cast<int>(points.size()));
   if (!targets || c < 0) return false;
   const Eigen::Vector2d start = domain.to_chart(c, layout.points[v]);
-  const int flips = star_flips(domain, F, stars, layout, v, layout.points[v]);
-  double allowed_error = -1;  // the guard's allowance, computed when a candidate first needs it
-  double best = current;
-  std::optional<BasePoint> best_point;
-  Eigen::Vector3d best_x = x;
+  // The candidates that raise the star's smallest quality, best first: the flip count and the
+  // guard, the costly checks, then run only until one passes.
+  boost::container::small_vector<RepairCandidate, 9> better;
   for (const Eigen::Vector3d& target : *targets) {
     Eigen::Vector3d move = target - x;
     move -= move.dot(*normal) * *normal;
@@ -277,21 +285,24 @@ bool repair_vertex(const RowMatrixX3i& F, const VertexStars& stars, const BaseDo
       if (!p) continue;
       const Eigen::Vector3d lifted = lift.lift(*p);
       const double quality = star_quality(layout.X, F, stars, v, lifted);
-      if (!(quality > best + 1e-9) || star_flips(domain, F, stars, layout, v, *p) > flips) continue;
-      if (options.error_tolerance >= 0) {
-        if (allowed_error < 0)
-          allowed_error = std::max(surface_error_on_base(F, stars, domain, lift, layout, c, v, start, x, x),
-                                   options.error_tolerance * mean_edge);
-        if (surface_error_on_base(F, stars, domain, lift, layout, c, v, q, lifted, x) > allowed_error) continue;
-      }
-      best = quality;
-      best_point = p;
-      best_x = lifted;
+      if (quality > current + 1e-9) better.push_back({quality, q, *p, lifted});
     }
   }
-  if (!best_point) return false;
-  layout.points[v] = *best_point;
-  layout.X.row(v) = best_x.transpose();
+  if (better.empty()) return false;
+  const int flips = star_flips(domain, F, stars, layout, v, layout.points[v]);
+  double allowed_error = -1;  // the guard's allowance, computed when a candidate first needs it
+  const RepairCandidate* chosen = best_passing(better, [&](const RepairCandidate& candidate) {
+    if (star_flips(domain, F, stars, layout, v, candidate.point) > flips) return false;
+    if (options.error_tolerance < 0) return true;
+    if (allowed_error < 0)
+      allowed_error = std::max(surface_error_on_base(F, stars, domain, lift, layout, c, v, start, x, x),
+                               options.error_tolerance * mean_edge);
+    return !(surface_error_on_base(F, stars, domain, lift, layout, c, v, candidate.chart, candidate.x, x) >
+             allowed_error);
+  });
+  if (!chosen) return false;
+  layout.points[v] = chosen->point;
+  layout.X.row(v) = chosen->x.transpose();
   return true;
 }
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include <Eigen/Dense>
+#include <boost/container/small_vector.hpp>
 
 #include "mesh/quality.h"
 #include "mesh/trimesh.h"
@@ -117,17 +118,22 @@ inline double smallest_quality(const RowMatrixX3d& X, const RowMatrixX3i& F) {
 /// distance between an edge's 3D midpoint and `lifted_midpoint(w)`, the lift of the midpoint of
 /// the edge v–w in D (nullopt where there is none: the error is then infinite), and the distance
 /// from `old` (v before the move, on the surface) to the triangles: a move off a ridge or a tip
-/// leaves it away from them. The neighbours are visited in the order of v's star.
+/// leaves it away from them. The neighbours are visited in the order of v's star, each once.
 template <class LiftedMidpoint>
 double star_surface_error(const RowMatrixX3d& X, const RowMatrixX3i& F, const VertexStars& stars, int v,
                           const Eigen::Vector3d& x, const Eigen::Vector3d& old, LiftedMidpoint&& lifted_midpoint) {
   double error = 0, to_old = std::numeric_limits<double>::infinity();
+  // A neighbour inside the star is in two of its faces; its midpoint's lift (a point location)
+  // is the costly part, so it is done once.
+  boost::container::small_vector<int, 16> measured;
   for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
     const int f = stars.faces[i];
     int k = 0;
     while (F(f, k) != v) ++k;
     const int a = F(f, (k + 1) % 3), b = F(f, (k + 2) % 3);
     for (const int w : {a, b}) {
+      if (std::find(measured.begin(), measured.end(), w) != measured.end()) continue;
+      measured.push_back(w);
       const std::optional<Eigen::Vector3d> mid = lifted_midpoint(w);
       if (!mid) return std::numeric_limits<double>::infinity();
       error = std::max(error, (*mid - 0.5 * (x + X.row(w).transpose())).norm());
@@ -135,6 +141,18 @@ double star_surface_error(const RowMatrixX3d& X, const RowMatrixX3i& F, const Ve
     to_old = std::min(to_old, point_triangle_distance(old, x, X.row(a).transpose(), X.row(b).transpose()));
   }
   return std::max(error, to_old);
+}
+
+/// The best of the repair's candidates (each with a quality `q`) that `passes`, or null: they are
+/// tried from the best down, equals in their order, so that the costly checks in `passes` run
+/// only until one passes, and the one kept is the one a scan keeping the best passing
+/// candidate so far would keep (but for qualities within 1e-9 of each other).
+template <class Candidates, class Passes>
+const typename Candidates::value_type* best_passing(Candidates& candidates, Passes&& passes) {
+  std::stable_sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) { return a.q > b.q; });
+  for (const auto& candidate : candidates)
+    if (passes(candidate)) return &candidate;
+  return nullptr;
 }
 
 /// Where the repair of the worst triangles (triangle_repair.h, base_levels.h) tries to move

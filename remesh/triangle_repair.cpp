@@ -8,12 +8,24 @@
 #include <utility>
 
 #include <Eigen/Dense>
+#include <boost/container/small_vector.hpp>
 
 #include "mesh/quality.h"
 #include "remesh/lift.h"
 #include "remesh/surface_moves.h"
 
 namespace mrsnake {
+namespace {
+
+// A move of the repair: v at u in D, lifted to x (found from `hint`), its star's smallest quality q.
+struct Candidate {
+  double q;
+  Eigen::Vector3d u, x;
+  int hint;
+};
+
+}  // namespace
+
 TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& F, const DomainMesh& param,
                                            const RowMatrixX3d& surface_V, RowMatrixX3d& U, RowMatrixX3d& X,
                                            std::vector<int>& hints, const TriangleRepairOptions& options) {
@@ -84,11 +96,9 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
         const std::optional<TrianglePullback> pullback = TrianglePullback::of(surface_V, PD, PF, hints[v]);
         if (!pullback) continue;
         const Eigen::Vector3d u = U.row(v);
-        // The guard's allowance, computed when a candidate first needs it.
-        double allowed_error = -1;
-        double best = current;
-        Eigen::Vector3d best_u = u, best_x = x;
-        int best_hint = hints[v];
+        // The candidates that raise the star's smallest quality, best first: the guard, the
+        // costly check, then runs only until one passes.
+        boost::container::small_vector<Candidate, 9> better;
         for (const Eigen::Vector3d& target : *targets) {
           Eigen::Vector3d move = target - x;
           move -= move.dot(*normal) * *normal;
@@ -99,22 +109,20 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
             int hint = hints[v];
             const Eigen::Vector3d lifted = lift(candidate, hint);
             const double q = star_quality(X, F, stars, v, lifted);
-            if (!(q > best + 1e-9)) continue;
-            if (options.guard_surface_error) {
-              if (allowed_error < 0)
-                allowed_error = std::max(surface_error(v, u, x, x), options.error_tolerance * mean_edge);
-              if (surface_error(v, candidate, lifted, x) > allowed_error) continue;
-            }
-            best = q;
-            best_u = candidate;
-            best_x = lifted;
-            best_hint = hint;
+            if (q > current + 1e-9) better.push_back({q, candidate, lifted, hint});
           }
         }
-        if (!(best > current + 1e-9)) continue;
-        U.row(v) = best_u.transpose();
-        X.row(v) = best_x.transpose();
-        hints[v] = best_hint;
+        double allowed_error = -1;  // computed when a candidate first needs it
+        const Candidate* chosen = best_passing(better, [&](const Candidate& c) {
+          if (!options.guard_surface_error) return true;
+          if (allowed_error < 0)
+            allowed_error = std::max(surface_error(v, u, x, x), options.error_tolerance * mean_edge);
+          return !(surface_error(v, c.u, c.x, x) > allowed_error);
+        });
+        if (!chosen) continue;
+        U.row(v) = chosen->u.transpose();
+        X.row(v) = chosen->x.transpose();
+        hints[v] = chosen->hint;
         for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) update_quality(stars.faces[i]);
         retries.moved(v);
         ++moved;
