@@ -191,6 +191,13 @@ BaseDomain::ChartList BaseDomain::charts_holding(const BasePoint& p) const {
   return charts;
 }
 
+std::optional<Eigen::Vector2d> BaseDomain::chart_point(int v, const BasePoint& p) const {
+  Eigen::Vector3d bary;
+  const int slot = star_slot(v, p, bary);
+  if (slot < 0) return std::nullopt;
+  return Eigen::Vector2d(star_corners_[slot] * bary);
+}
+
 Eigen::Vector2d BaseDomain::to_chart(int v, const BasePoint& p) const {
   Eigen::Vector3d bary;
   const int slot = star_slot(v, p, bary);
@@ -257,9 +264,12 @@ double BaseDomain::orientation(const BasePoint& a, const BasePoint& b, const Bas
 
 bool BaseDomain::counter_clockwise(const BasePoint& a, const BasePoint& b, const BasePoint& c) const {
   for (int v : charts_holding(a)) {
-    if (!in_star(v, b) || !in_star(v, c)) continue;
+    const std::optional<Eigen::Vector2d> qb = chart_point(v, b);
+    if (!qb) continue;
+    const std::optional<Eigen::Vector2d> qc = chart_point(v, c);
+    if (!qc) continue;
     const Eigen::Vector2d qa = to_chart(v, a);
-    if (cross2(to_chart(v, b) - qa, to_chart(v, c) - qa) > 0) return true;
+    if (cross2(*qb - qa, *qc - qa) > 0) return true;
   }
   return false;
 }

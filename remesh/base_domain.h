@@ -89,6 +89,12 @@ class BaseDomain {
   /// \throw std::invalid_argument if p is not in v's star.
   Eigen::Vector2d to_chart(int v, const BasePoint& p) const;
 
+  /// p's position in v's chart (as to_chart), or nullopt where v's star does not hold p: one
+  /// search of the star where in_star() then to_chart() make two.
+  /// \pre v is a vertex of K, p a point of D.
+  /// \throw nothing.
+  std::optional<Eigen::Vector2d> chart_point(int v, const BasePoint& p) const;
+
   /// The point at q in v's chart: the star face holding q (barycentric coordinates >=
   /// -kChartSlack, clamped to >= 0 and renormalized; the most inside face when q is on an
   /// edge), or nullopt if q is outside the star.

@@ -35,13 +35,19 @@ std::optional<BasePoint> edge_midpoint(const BaseDomain& domain, const BasePoint
   std::optional<BasePoint> best, fallback;
   double best_depth = -1;
   for (const int c : domain.charts_holding(a)) {
-    if (!domain.in_star(c, b)) continue;
-    const Eigen::Vector2d qa = domain.to_chart(c, a), qb = domain.to_chart(c, b);
+    const std::optional<Eigen::Vector2d> chart_b = domain.chart_point(c, b);
+    if (!chart_b) continue;
+    const Eigen::Vector2d qa = domain.to_chart(c, a), qb = *chart_b;
     const std::optional<BasePoint> mid = domain.from_chart(c, 0.5 * (qa + qb));
     if (!mid) continue;
     if (!fallback) fallback = mid;
-    const bool left_ok = !left || (domain.in_star(c, *left) && cross2(qa, qb, domain.to_chart(c, *left)) > 0);
-    const bool right_ok = !right || (domain.in_star(c, *right) && cross2(qb, qa, domain.to_chart(c, *right)) > 0);
+    // Whether the apex, if any, is in the chart on the side a -> b -> apex is counter-clockwise.
+    const auto apex_ok = [&](const BasePoint* apex, const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
+      if (!apex) return true;
+      const std::optional<Eigen::Vector2d> q = domain.chart_point(c, *apex);
+      return q && cross2(from, to, *q) > 0;
+    };
+    const bool left_ok = apex_ok(left, qa, qb), right_ok = apex_ok(right, qb, qa);
     if (!left_ok || !right_ok) continue;
     const double depth = domain.depth(c, a) + domain.depth(c, b) + (left ? domain.depth(c, *left) : 0.0) +
                          (right ? domain.depth(c, *right) : 0.0);
@@ -83,8 +89,9 @@ std::optional<Eigen::Vector2d> pull_back(const BaseDomain& domain, const BaseLif
   std::array<Eigen::Vector2d, 3> corner;
   for (int k = 0; k < 3; ++k) {
     const BasePoint& q = lift.location(F(hit.face, k));
-    if (!domain.in_star(c, q)) return std::nullopt;
-    corner[k] = domain.to_chart(c, q);
+    const std::optional<Eigen::Vector2d> in_chart = domain.chart_point(c, q);
+    if (!in_chart) return std::nullopt;
+    corner[k] = *in_chart;
   }
   for (int k = 0; k < 2; ++k) {
     edges_3d.col(k) = (V.row(F(hit.face, k + 1)) - V.row(F(hit.face, 0))).transpose();
