@@ -170,6 +170,31 @@ TEST(BaseDomain, InStarFollowsTheFacesAroundEdgesAndVertices) {
   }
 }
 
+// chart_point is in_star and to_chart in one: nullopt exactly where the star does not hold the
+// point (inside a face, on an edge, at a corner), else the same chart position, bit for bit.
+TEST(BaseDomain, ChartPointIsInStarThenToChart) {
+  for (const TriMesh& base : bases()) {
+    const BaseDomain domain(base);
+    int held = 0, outside = 0;
+    for (int f = 0; f < base.num_faces(); ++f)
+      for (const Eigen::Vector3d& bary :
+           {Eigen::Vector3d(0.2, 0.3, 0.5), Eigen::Vector3d(0.3, 0.7, 0.0), Eigen::Vector3d(0.0, 0.0, 1.0)})
+        for (int v = 0; v < base.num_vertices(); ++v) {
+          const BasePoint p = at(f, bary);
+          const std::optional<Eigen::Vector2d> q = domain.chart_point(v, p);
+          ASSERT_EQ(q.has_value(), domain.in_star(v, p));
+          if (!q) {
+            ++outside;
+            continue;
+          }
+          ++held;
+          EXPECT_EQ(*q, domain.to_chart(v, p));
+        }
+    EXPECT_GT(held, 0);
+    EXPECT_GT(outside, held);  // a star holds a few faces of many
+  }
+}
+
 // A point on an edge named by either face, or a vertex named by any face of its star, has
 // one position in every chart that holds it.
 TEST(BaseDomain, APointOnASharedEdgeHasOneChartPosition) {
