@@ -201,16 +201,21 @@ class RepairRetries {
         if (moved_at_[F_(stars_.faces[i], k)] > failed_at_[v]) return true;
     return false;
   }
-  void failed(int v) { failed_at_[v] = ++clock_; }
-  void moved(int v) {
+  /// v failed or moved, stamped by the clock of `part` (split_sweep.h): parts that run side by
+  /// side keep their own clocks, and never compare each other's stamps.
+  void failed(int v, int part = 0) { failed_at_[v] = ++clock_[part]; }
+  void moved(int v, int part = 0) {
     failed_at_[v] = -1;
-    moved_at_[v] = ++clock_;
+    moved_at_[v] = ++clock_[part];
   }
+  /// After parts ran side by side: every clock goes on from the latest stamp, so that later
+  /// stamps are larger than all of theirs.
+  void join_parts() { clock_.fill(*std::max_element(clock_.begin(), clock_.end())); }
 
  private:
   const RowMatrixX3i& F_;
   const VertexStars& stars_;
-  long clock_ = 0;
+  std::array<long, 3> clock_{};
   std::vector<long> moved_at_, failed_at_;
 };
 

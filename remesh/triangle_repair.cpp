@@ -12,6 +12,7 @@
 
 #include "mesh/quality.h"
 #include "remesh/lift.h"
+#include "remesh/split_sweep.h"
 #include "remesh/surface_moves.h"
 
 namespace mrsnake {
@@ -24,113 +25,180 @@ struct Candidate {
   int hint;
 };
 
+// The repair of one level: the level, its domain, and each face's quality kept current as
+// vertices move (the sweeps' scans and the smallest quality before and after read it).
+class Repair {
+ public:
+  Repair(DomainKind kind, const RowMatrixX3i& F, const DomainMesh& param, const RowMatrixX3d& surface_V,
+         RowMatrixX3d& U, RowMatrixX3d& X, std::vector<int>& hints, const TriangleRepairOptions& options)
+      : kind_(kind),
+        F_(F),
+        param_(param),
+        surface_V_(surface_V),
+        U_(U),
+        X_(X),
+        hints_(hints),
+        options_(options),
+        stars_(F, static_cast<int>(U.rows())),
+        boundary_(kind == DomainKind::disk ? boundary_vertices(F, stars_)
+                                           : std::vector<bool>(static_cast<std::size_t>(U.rows()), false)),
+        mean_edge_(mean_edge_length(X, F)),
+        face_quality_(static_cast<std::size_t>(F.rows())) {
+    for (int f = 0; f < F.rows(); ++f) update_quality(f);
+  }
+
+  const VertexStars& stars() const { return stars_; }
+
+  double smallest_quality() const {
+    return face_quality_.empty() ? 0.0 : *std::min_element(face_quality_.begin(), face_quality_.end());
+  }
+
+  // The faces below the threshold, worst first.
+  std::vector<std::pair<double, int>> poor_faces() const {
+    std::vector<std::pair<double, int>> poor;
+    for (int f = 0; f < static_cast<int>(face_quality_.size()); ++f)
+      if (face_quality_[f] < options_.threshold) poor.emplace_back(face_quality_[f], f);
+    std::sort(poor.begin(), poor.end());
+    return poor;
+  }
+
+  // Whether v may move at all: not a fixed vertex, nor a rim vertex when the rim stays.
+  bool movable(int v) const {
+    return !(boundary_[v] && !options_.move_rim) && !(options_.fixed && (*options_.fixed)[v]);
+  }
+
+  // v to its best candidate, if one raises its star's smallest quality within the guard.
+  // Writes only v and the qualities of its star's faces. Returns whether v moved.
+  bool repair_vertex(int v) {
+    const std::optional<Candidate> chosen = best_move(v);
+    if (!chosen) return false;
+    U_.row(v) = chosen->u.transpose();
+    X_.row(v) = chosen->x.transpose();
+    hints_[v] = chosen->hint;
+    for (int i = stars_.offset[v]; i < stars_.offset[v + 1]; ++i) update_quality(stars_.faces[i]);
+    return true;
+  }
+
+ private:
+  void update_quality(int f) {
+    face_quality_[f] = frey_borouchaki_quality(X_.row(F_(f, 0)).transpose(), X_.row(F_(f, 1)).transpose(),
+                                               X_.row(F_(f, 2)).transpose());
+  }
+
+  Eigen::Vector3d lift(const Eigen::Vector3d& u, int& hint) const {
+    const DomainMesh::Location loc = param_.locate(u, hint);
+    hint = loc.face;
+    const Eigen::Vector3d lifted = lift_location(surface_V_, param_.faces(), loc);
+    return options_.project_onto ? Eigen::Vector3d(options_.project_onto->closest(lifted).point) : lifted;
+  }
+
+  // How far v's triangles (v at u in D, x in 3D) leave the surface (star_surface_error), the
+  // midpoints lifted through D with one walking hint.
+  double surface_error(int v, const Eigen::Vector3d& u, const Eigen::Vector3d& x, const Eigen::Vector3d& old) const {
+    int hint = hints_[v];
+    return star_surface_error(X_, F_, stars_, v, x, old, [&](int w) -> std::optional<Eigen::Vector3d> {
+      return lift(project_to_domain(kind_, 0.5 * (u + U_.row(w).transpose()), false), hint);
+    });
+  }
+
+  // The candidates (repair_targets() at full, half and quarter steps, pulled back to D through
+  // the affine map of the input triangle under v) that keep v's star unflipped in D and raise
+  // its smallest quality above `current`.
+  boost::container::small_vector<Candidate, 9> better_candidates(int v, double current) const {
+    boost::container::small_vector<Candidate, 9> better;
+    const std::optional<Eigen::Vector3d> normal = vertex_normal(X_, F_, stars_, v);
+    if (!normal) return better;
+    const std::optional<std::array<Eigen::Vector3d, 3>> targets = repair_targets(X_, F_, stars_, v, *normal);
+    const std::optional<TrianglePullback> pullback =
+        TrianglePullback::of(surface_V_, param_.positions(), param_.faces(), hints_[v]);
+    if (!targets || !pullback) return better;
+    const Eigen::Vector3d x = X_.row(v), u = U_.row(v);
+    for (const Eigen::Vector3d& target : *targets) {
+      Eigen::Vector3d move = target - x;
+      move -= move.dot(*normal) * *normal;
+      const Eigen::Vector3d domain_move = pullback->to_domain(move);
+      for (double t : {1.0, 0.5, 0.25}) {
+        const Eigen::Vector3d candidate = project_to_domain(kind_, u + t * domain_move, boundary_[v]);
+        if (!star_unflipped_in_domain(U_, F_, stars_, v, candidate)) continue;
+        int hint = hints_[v];
+        const Eigen::Vector3d lifted = lift(candidate, hint);
+        const double q = star_quality(X_, F_, stars_, v, lifted);
+        if (q > current + 1e-9) better.push_back({q, candidate, lifted, hint});
+      }
+    }
+    return better;
+  }
+
+  // The best candidate within the guard, tried best first: the guard, the costly check, runs
+  // only until one passes.
+  std::optional<Candidate> best_move(int v) const {
+    const Eigen::Vector3d x = X_.row(v), u = U_.row(v);
+    const double current = star_quality(X_, F_, stars_, v, x);
+    if (!(current < options_.threshold)) return std::nullopt;
+    boost::container::small_vector<Candidate, 9> better = better_candidates(v, current);
+    double allowed_error = -1;  // computed when a candidate first needs it
+    const Candidate* chosen = best_passing(better, [&](const Candidate& c) {
+      if (!options_.guard_surface_error) return true;
+      if (allowed_error < 0) allowed_error = std::max(surface_error(v, u, x, x), options_.error_tolerance * mean_edge_);
+      return !(surface_error(v, c.u, c.x, x) > allowed_error);
+    });
+    if (!chosen) return std::nullopt;
+    return *chosen;
+  }
+
+  const DomainKind kind_;
+  const RowMatrixX3i& F_;
+  const DomainMesh& param_;
+  const RowMatrixX3d& surface_V_;
+  RowMatrixX3d& U_;
+  RowMatrixX3d& X_;
+  std::vector<int>& hints_;
+  const TriangleRepairOptions& options_;
+  const VertexStars stars_;
+  const std::vector<bool> boundary_;
+  const double mean_edge_;
+  std::vector<double> face_quality_;
+};
+
 }  // namespace
 
 TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& F, const DomainMesh& param,
                                            const RowMatrixX3d& surface_V, RowMatrixX3d& U, RowMatrixX3d& X,
                                            std::vector<int>& hints, const TriangleRepairOptions& options) {
   const int n = static_cast<int>(U.rows());
-  const int m = static_cast<int>(F.rows());
-  const VertexStars stars(F, n);
-  const std::vector<bool> boundary =
-      kind == DomainKind::disk ? boundary_vertices(F, stars) : std::vector<bool>(n, false);
-  const auto& PF = param.faces();
-  const auto& PD = param.positions();
-  auto quality = [&](int f, int v, const Eigen::Vector3d& x) {
-    Eigen::Vector3d P[3] = {X.row(F(f, 0)), X.row(F(f, 1)), X.row(F(f, 2))};
-    for (int k = 0; k < 3; ++k)
-      if (F(f, k) == v) P[k] = x;
-    return frey_borouchaki_quality(P[0], P[1], P[2]);
-  };
-  auto lift = [&](const Eigen::Vector3d& u, int& hint) {
-    const DomainMesh::Location loc = param.locate(u, hint);
-    hint = loc.face;
-    const Eigen::Vector3d lifted = lift_location(surface_V, PF, loc);
-    return options.project_onto ? Eigen::Vector3d(options.project_onto->closest(lifted).point) : lifted;
-  };
-  // How far v's triangles (v at u in D, x in 3D) leave the surface (star_surface_error), the
-  // midpoints lifted through D with one walking hint.
-  auto surface_error = [&](int v, const Eigen::Vector3d& u, const Eigen::Vector3d& x, const Eigen::Vector3d& old) {
-    int hint = hints[v];
-    return star_surface_error(X, F, stars, v, x, old, [&](int w) -> std::optional<Eigen::Vector3d> {
-      return lift(project_to_domain(kind, 0.5 * (u + U.row(w).transpose()), false), hint);
-    });
-  };
-  const double mean_edge = mean_edge_length(X, F);
-
-  // Each face's quality, kept current as vertices move: the sweeps' scans and the smallest
-  // quality before and after read it.
-  std::vector<double> face_quality(m);
-  auto update_quality = [&](int f) { face_quality[f] = quality(f, -1, Eigen::Vector3d::Zero()); };
-  auto smallest = [&] { return m > 0 ? *std::min_element(face_quality.begin(), face_quality.end()) : 0.0; };
-  for (int f = 0; f < m; ++f) update_quality(f);
-
+  Repair repair(kind, F, param, surface_V, U, X, hints, options);
+  const SplitSweep split(X, F, repair.stars());
   TriangleRepairStats stats;
-  stats.q_min_before = smallest();
-  std::vector<std::pair<double, int>> poor;
+  stats.q_min_before = repair.smallest_quality();
   std::vector<int> visited(n, -1);
-  RepairRetries retries(F, stars, n);
+  RepairRetries retries(F, repair.stars(), n);
   for (int sweep = 0; sweep < options.sweeps; ++sweep) {
-    poor.clear();
-    for (int f = 0; f < m; ++f)
-      if (face_quality[f] < options.threshold) poor.emplace_back(face_quality[f], f);
+    const std::vector<std::pair<double, int>> poor = repair.poor_faces();
     if (poor.empty()) break;
-    std::sort(poor.begin(), poor.end());
-    int moved = 0;
-    for (const auto& [q_face, face] : poor)
-      for (int corner = 0; corner < 3; ++corner) {
-        const int v = F(face, corner);
-        if (visited[v] == sweep || (boundary[v] && !options.move_rim)) continue;
-        if (options.fixed && (*options.fixed)[v]) continue;
-        visited[v] = sweep;
-        if (!retries.worth_trying(v)) continue;
-        retries.failed(v);  // undone below if v moves
-        const Eigen::Vector3d x = X.row(v);
-        const double current = star_quality(X, F, stars, v, x);
-        if (!(current < options.threshold)) continue;
-        const std::optional<Eigen::Vector3d> normal = vertex_normal(X, F, stars, v);
-        if (!normal) continue;
-        const std::optional<std::array<Eigen::Vector3d, 3>> targets = repair_targets(X, F, stars, v, *normal);
-        if (!targets) continue;
-        // The affine map of the input triangle under v pulls a 3D move back to D.
-        const std::optional<TrianglePullback> pullback = TrianglePullback::of(surface_V, PD, PF, hints[v]);
-        if (!pullback) continue;
-        const Eigen::Vector3d u = U.row(v);
-        // The candidates that raise the star's smallest quality, best first: the guard, the
-        // costly check, then runs only until one passes.
-        boost::container::small_vector<Candidate, 9> better;
-        for (const Eigen::Vector3d& target : *targets) {
-          Eigen::Vector3d move = target - x;
-          move -= move.dot(*normal) * *normal;
-          const Eigen::Vector3d domain_move = pullback->to_domain(move);
-          for (double t : {1.0, 0.5, 0.25}) {
-            const Eigen::Vector3d candidate = project_to_domain(kind, u + t * domain_move, boundary[v]);
-            if (!star_unflipped_in_domain(U, F, stars, v, candidate)) continue;
-            int hint = hints[v];
-            const Eigen::Vector3d lifted = lift(candidate, hint);
-            const double q = star_quality(X, F, stars, v, lifted);
-            if (q > current + 1e-9) better.push_back({q, candidate, lifted, hint});
+    // Each part visits its vertices of the poor faces, worst face first.
+    std::array<int, SplitSweep::kParts> moved{};
+    split.run([&](int part) {
+      if (part == SplitSweep::kBand) retries.join_parts();
+      for (const auto& [q_face, face] : poor)
+        for (int corner = 0; corner < 3; ++corner) {
+          const int v = F(face, corner);
+          if (split.part(v) != part || visited[v] == sweep || !repair.movable(v)) continue;
+          visited[v] = sweep;
+          if (!retries.worth_trying(v)) continue;
+          if (repair.repair_vertex(v)) {
+            retries.moved(v, part);
+            ++moved[part];
+          } else {
+            retries.failed(v, part);
           }
         }
-        double allowed_error = -1;  // computed when a candidate first needs it
-        const Candidate* chosen = best_passing(better, [&](const Candidate& c) {
-          if (!options.guard_surface_error) return true;
-          if (allowed_error < 0)
-            allowed_error = std::max(surface_error(v, u, x, x), options.error_tolerance * mean_edge);
-          return !(surface_error(v, c.u, c.x, x) > allowed_error);
-        });
-        if (!chosen) continue;
-        U.row(v) = chosen->u.transpose();
-        X.row(v) = chosen->x.transpose();
-        hints[v] = chosen->hint;
-        for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) update_quality(stars.faces[i]);
-        retries.moved(v);
-        ++moved;
-      }
-    stats.moves += moved;
-    if (moved == 0) break;
+    });
+    retries.join_parts();
+    const int moves = moved[0] + moved[1] + moved[2];
+    stats.moves += moves;
+    if (moves == 0) break;
   }
-  stats.q_min_after = smallest();
+  stats.q_min_after = repair.smallest_quality();
   return stats;
 }
 
