@@ -81,18 +81,18 @@ double star_smallest_angle(const RowMatrixX3d& X, const RowMatrixX3i& F, const V
   return smallest;
 }
 
-// The level vertex nearest to the point p: the closest corner of `face`.
-int nearest_corner(const RowMatrixX3d& X, const RowMatrixX3i& F, int face, const Eigen::Vector3d& p) {
-  int v = -1;
-  double best = std::numeric_limits<double>::infinity();
-  for (int k = 0; k < 3; ++k) {
-    const int w = F(face, k);
-    if (const double d = (X.row(w).transpose() - p).squaredNorm(); d < best) {
-      best = d;
-      v = w;
-    }
-  }
-  return v;
+// What a snap of a level vertex onto a tip comes to.
+enum class SnapVerdict { take, refuse, tip_already_close };
+
+// The corners of a level face, nearest to p first.
+std::array<int, 3> corners_nearest_first(const RowMatrixX3d& X, const RowMatrixX3i& F, int face,
+                                         const Eigen::Vector3d& p) {
+  std::array<int, 3> corners = {F(face, 0), F(face, 1), F(face, 2)};
+  std::array<double, 3> distance;
+  for (int k = 0; k < 3; ++k) distance[k] = (X.row(corners[k]).transpose() - p).squaredNorm();
+  std::array<int, 3> order = {0, 1, 2};
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return distance[a] < distance[b]; });
+  return {corners[order[0]], corners[order[1]], corners[order[2]]};
 }
 
 // The faces of v's star and of its neighbours' stars: the triangles a move of v can change the
@@ -189,27 +189,39 @@ int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMa
   const RowMatrixX3d X_before = X;
   int snaps = 0, judged = 0;
   const int max_judged = 8 * options.max_snaps;  // the region error is the costly part
-  for (int s : far_tips(input, far_threshold, input_F, input_rim)) {
-    if (snaps >= options.max_snaps || judged >= max_judged) break;
-    const Eigen::Vector3d x = surface_V.row(s).transpose();
-    const int v = nearest_corner(X, F, input.nearest_face[s], x);
-    if (v < 0 || moved[v] || rim[v]) continue;
+  // Whether snapping v onto input vertex s (at x) is worth it.
+  const auto judge_snap = [&](int v, int s, const Eigen::Vector3d& x) {
+    if (moved[v] || rim[v]) return SnapVerdict::refuse;
     const Eigen::Vector3d x_old = X.row(v).transpose();
     region.collect(v);
     // An earlier snap nearby may have fixed this tip already: its distance now, not before.
-    if (!(region.distance(x, v, x_old) > threshold)) continue;
-    if (!domain.allowed(v, s)) continue;
+    if (!(region.distance(x, v, x_old) > threshold)) return SnapVerdict::tip_already_close;
+    if (!domain.allowed(v, s)) return SnapVerdict::refuse;
     if (star_quality(X, F, stars, v, x) < options.min_quality ||
         star_smallest_angle(X, F, stars, v, x) < options.min_angle_deg)
-      continue;
+      return SnapVerdict::refuse;
     // Worth it only if the input around v ends up really closer to the level: moving v onto s
     // also moves its triangles away from the input v stood on.
     ++judged;
-    if (!(region.error(v, x) <= (1 - options.min_gain) * region.error(v, x_old))) continue;
-    domain.apply(v, s);
-    X.row(v) = x.transpose();
-    moved[v] = true;
-    ++snaps;
+    return region.error(v, x) <= (1 - options.min_gain) * region.error(v, x_old) ? SnapVerdict::take
+                                                                                 : SnapVerdict::refuse;
+  };
+  for (int s : far_tips(input, far_threshold, input_F, input_rim)) {
+    if (snaps >= options.max_snaps || judged >= max_judged) break;
+    const Eigen::Vector3d x = surface_V.row(s).transpose();
+    // The nearest corner of the tip's nearest face that can take it: the nearest may be held
+    // by its triangles' quality where the next one is not.
+    for (const int v : corners_nearest_first(X, F, input.nearest_face[s], x)) {
+      if (judged >= max_judged) break;
+      const SnapVerdict verdict = judge_snap(v, s, x);
+      if (verdict == SnapVerdict::tip_already_close) break;
+      if (verdict != SnapVerdict::take) continue;
+      domain.apply(v, s);
+      X.row(v) = x.transpose();
+      moved[v] = true;
+      ++snaps;
+      break;
+    }
   }
   // The snaps cost triangle quality: keep them only if they really bring the input closer
   // overall (the largest distance drops), not only around each snapped vertex.

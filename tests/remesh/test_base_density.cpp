@@ -184,6 +184,65 @@ TEST(FeatureSnap, SnapsVerticesOntoTheTipsTheLevelCutsOff) {
   EXPECT_EQ(moved, snaps);
 }
 
+// A tip whose nearest level vertex cannot take it (a neighbour pulled in makes that vertex's
+// triangles too thin there) is snapped by the next corner of its face that can: a flat
+// triangle grid, and an input that is the same grid with one spike.
+TEST(FeatureSnap, ATipTheNearestCornerCannotTakeGoesToTheNextCorner) {
+  const int n = 7;
+  const auto at = [&](int i, int j) { return j * n + i; };
+  RowMatrixX3d X(n * n, 3);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) X.row(at(i, j)) << i + 0.5 * j, j * std::sqrt(3.0) / 2, 0;
+  std::vector<Eigen::RowVector3i> faces;
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) {
+      faces.emplace_back(at(i, j), at(i + 1, j), at(i, j + 1));
+      faces.emplace_back(at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+    }
+  const int nearest = at(3, 3), next = at(4, 3), third = at(3, 4);
+  X.row(at(3, 2)) << 4.45, 1.376, 0;                  // a neighbour of `nearest` only, pulled toward the tip's side
+  const Eigen::RowVector3d tip(4.937, 2.726, 0.454);  // above the face (nearest, next, third)
+  RowMatrixX3i F(static_cast<Eigen::Index>(faces.size()), 3), input_F(F.rows() + 2, 3);
+  int rows = 0;
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    F.row(static_cast<Eigen::Index>(f)) = faces[f];
+    if (faces[f] != Eigen::RowVector3i(nearest, next, third)) input_F.row(rows++) = faces[f];
+  }
+  ASSERT_EQ(rows, F.rows() - 1);
+  RowMatrixX3d input_V(n * n + 1, 3);
+  input_V << X, tip;
+  const int s = n * n;
+  input_F.row(rows++) << nearest, next, s;
+  input_F.row(rows++) << next, third, s;
+  input_F.row(rows++) << third, nearest, s;
+  // The nearest corner's triangles with it on the tip are below the bounds; the next corner's are not.
+  const VertexStars stars(F, n * n);
+  FeatureSnapOptions options;
+  const auto star_bounds_hold = [&](int v) {
+    RowMatrixX3d moved = X;
+    moved.row(v) = tip;
+    for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
+      const QualityReport q = mesh_quality(TriMesh{moved, RowMatrixX3i(F.row(stars.faces[i]))});
+      if (q.q_min < options.min_quality || q.min_angle_deg < options.min_angle_deg) return false;
+    }
+    return true;
+  };
+  ASSERT_LT((X.row(nearest) - tip).head<2>().norm(), (X.row(next) - tip).head<2>().norm());
+  ASSERT_FALSE(star_bounds_hold(nearest));
+  ASSERT_TRUE(star_bounds_hold(next));
+
+  const RowMatrixX3d X0 = X;
+  const SnapInDomain domain{[](int, int) { return true; }, [](int, int) {}, [] {}};
+  std::vector<bool> snapped;
+  const int snaps = snap_level_to_input_tips(F, X, input_V, input_F, boundary_vertices(F, n * n),
+                                             boundary_vertices(input_F, n * n + 1), domain, options, &snapped);
+  ASSERT_EQ(snaps, 1);
+  EXPECT_TRUE(snapped[next]);
+  EXPECT_TRUE(X.row(next) == tip);
+  for (int v = 0; v < n * n; ++v)
+    if (v != next) EXPECT_TRUE(X.row(v) == X0.row(v)) << v;
+}
+
 // A snap must bring the input around the vertex really closer to the level: asking for the
 // largest distance there to drop to zero refuses every snap (the input between the level's
 // vertices stays off its flat triangles), and leaves U, X and hints as they were; a zero
