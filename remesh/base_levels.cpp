@@ -358,9 +358,23 @@ int snap_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLift
                  const FeatureSnapOptions& options, std::vector<bool>* snapped) {
   const VertexStars stars(F, static_cast<int>(layout.points.size()));
   const std::vector<BasePoint> before = layout.points;
-  const SnapInDomain moves{[&](int v, int s) { return star_flips(domain, F, stars, layout, v, lift.location(s)) == 0; },
-                           [&](int v, int s) { layout.points[v] = lift.location(s); }, [&] { layout.points = before; }};
   const RowMatrixX3d& input_V = lift.input_vertices();
+  // v the fraction t of the way to input vertex s's point, in a chart holding both (exactly
+  // that point at t = 1).
+  const auto point_toward = [&](int v, int s, double t) -> std::optional<BasePoint> {
+    const BasePoint ends[2] = {layout.points[v], lift.location(s)};
+    if (t == 1) return ends[1];
+    const int c = domain.common_chart(ends, 2);
+    if (c < 0) return std::nullopt;
+    return domain.from_chart(c, (1 - t) * domain.to_chart(c, ends[0]) + t * domain.to_chart(c, ends[1]));
+  };
+  const auto toward = [&](int v, int s, double t) -> std::optional<Eigen::Vector3d> {
+    const std::optional<BasePoint> p = point_toward(v, s, t);
+    if (!p || star_flips(domain, F, stars, layout, v, *p) != 0) return std::nullopt;
+    return t == 1 ? Eigen::Vector3d(input_V.row(s).transpose()) : lift.lift(*p);
+  };
+  const SnapInDomain moves{toward, [&](int v, int s, double t) { layout.points[v] = *point_toward(v, s, t); },
+                           [&] { layout.points = before; }};
   const RowMatrixX3i& input_F = lift.input_faces();
   return snap_level_to_input_tips(F, layout.X, input_V, input_F, boundary_vertices(F, stars),
                                   boundary_vertices(input_F, static_cast<int>(input_V.rows())), moves, options,

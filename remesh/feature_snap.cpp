@@ -1,5 +1,7 @@
 #include "remesh/feature_snap.h"
 
+#include "remesh/lift.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -189,39 +191,45 @@ int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMa
   const RowMatrixX3d X_before = X;
   int snaps = 0, judged = 0;
   const int max_judged = 8 * options.max_snaps;  // the region error is the costly part
-  // Whether snapping v onto input vertex s (at x) is worth it.
-  const auto judge_snap = [&](int v, int s, const Eigen::Vector3d& x) {
-    if (moved[v] || rim[v]) return SnapVerdict::refuse;
+  // Whether moving v the fraction t of the way to input vertex s (at x) is worth it, and where to.
+  struct Verdict {
+    SnapVerdict verdict;
+    Eigen::Vector3d position;
+  };
+  const auto judge_snap = [&](int v, int s, const Eigen::Vector3d& x, double t) -> Verdict {
+    const Verdict refuse{SnapVerdict::refuse, Eigen::Vector3d::Zero()};
+    if (moved[v] || rim[v]) return refuse;
     const Eigen::Vector3d x_old = X.row(v).transpose();
     region.collect(v);
     // An earlier snap nearby may have fixed this tip already: its distance now, not before.
-    if (!(region.distance(x, v, x_old) > threshold)) return SnapVerdict::tip_already_close;
-    if (!domain.allowed(v, s)) return SnapVerdict::refuse;
-    if (star_quality(X, F, stars, v, x) < options.min_quality ||
-        star_smallest_angle(X, F, stars, v, x) < options.min_angle_deg)
-      return SnapVerdict::refuse;
+    if (!(region.distance(x, v, x_old) > threshold)) return {SnapVerdict::tip_already_close, x_old};
+    const std::optional<Eigen::Vector3d> to = domain.toward(v, s, t);
+    if (!to || star_quality(X, F, stars, v, *to) < options.min_quality ||
+        star_smallest_angle(X, F, stars, v, *to) < options.min_angle_deg)
+      return refuse;
     // Worth it only if the input around v ends up really closer to the level: moving v onto s
     // also moves its triangles away from the input v stood on.
     ++judged;
-    return region.error(v, x) <= (1 - options.min_gain) * region.error(v, x_old) ? SnapVerdict::take
-                                                                                 : SnapVerdict::refuse;
+    if (!(region.error(v, *to) <= (1 - options.min_gain) * region.error(v, x_old))) return refuse;
+    return {SnapVerdict::take, *to};
   };
   for (int s : far_tips(input, far_threshold, input_F, input_rim)) {
     if (snaps >= options.max_snaps || judged >= max_judged) break;
     const Eigen::Vector3d x = surface_V.row(s).transpose();
-    // The nearest corner of the tip's nearest face that can take it: the nearest may be held
-    // by its triangles' quality where the next one is not.
-    for (const int v : corners_nearest_first(X, F, input.nearest_face[s], x)) {
-      if (judged >= max_judged) break;
-      const SnapVerdict verdict = judge_snap(v, s, x);
-      if (verdict == SnapVerdict::tip_already_close) break;
-      if (verdict != SnapVerdict::take) continue;
-      domain.apply(v, s);
-      X.row(v) = x.transpose();
-      moved[v] = true;
-      ++snaps;
-      break;
-    }
+    // The nearest corner of the tip's nearest face that can take it (the nearest may be held by
+    // its triangles' quality where the next one is not), the whole way, else part of the way.
+    const std::array<int, 3> corners = corners_nearest_first(X, F, input.nearest_face[s], x);
+    bool done = false;
+    for (const double t : {1.0, 0.75, 0.5})
+      for (int k = 0; k < 3 && !done && judged < max_judged; ++k) {
+        const Verdict verdict = judge_snap(corners[k], s, x, t);
+        done = verdict.verdict != SnapVerdict::refuse;
+        if (verdict.verdict != SnapVerdict::take) continue;
+        domain.apply(corners[k], s, t);
+        X.row(corners[k]) = verdict.position.transpose();
+        moved[corners[k]] = true;
+        ++snaps;
+      }
   }
   // The snaps cost triangle quality: keep them only if they really bring the input closer
   // overall (the largest distance drops), not only around each snapped vertex.
@@ -249,12 +257,23 @@ int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh&
   const RowMatrixX3d U_before = U;
   const std::vector<int> hints_before = hints;
   const auto point_of = [&](int s) { return project_to_domain(kind, PD.row(s).transpose(), false); };
-  const SnapInDomain domain{[&](int v, int s) { return star_unflipped_in_domain(U, F, stars, v, point_of(s)); },
-                            [&](int v, int s) {
-                              U.row(v) = point_of(s).transpose();
-                              hints[v] = face_of[s];
-                            },
-                            [&] {
+  // v the fraction t of the way to input vertex s's point of D (exactly that point at t = 1).
+  const auto point_toward = [&](int v, int s, double t) -> Eigen::Vector3d {
+    return t == 1 ? point_of(s) : project_to_domain(kind, (1 - t) * U.row(v).transpose() + t * point_of(s), false);
+  };
+  const auto toward = [&](int v, int s, double t) -> std::optional<Eigen::Vector3d> {
+    const Eigen::Vector3d u = point_toward(v, s, t);
+    if (!star_unflipped_in_domain(U, F, stars, v, u)) return std::nullopt;
+    if (t == 1) return Eigen::Vector3d(surface_V.row(s).transpose());
+    int hint = hints[v];
+    return lift_location(surface_V, PF, param.locate(u, hint));
+  };
+  const auto apply = [&](int v, int s, double t) {
+    const Eigen::Vector3d u = point_toward(v, s, t);
+    hints[v] = t == 1 ? face_of[s] : param.locate(u, hints[v]).face;
+    U.row(v) = u.transpose();
+  };
+  const SnapInDomain domain{toward, apply, [&] {
                               U = U_before;
                               hints = hints_before;
                             }};

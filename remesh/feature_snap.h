@@ -7,11 +7,14 @@
 /// (exact lift: the vertex is the input vertex), when that flips nothing in D, leaves the
 /// vertex's triangles with Q >= min_quality and angles >= min_angle_deg, and really brings the
 /// input around the vertex closer to the level (moving a vertex onto a tip also moves its
-/// triangles off the input it stood on). A tip is judged by its distance to the level as it is
+/// triangles off the input it stood on). Where the nearest vertex cannot take the tip, the
+/// other corners of the tip's nearest face are tried; where none can, the same part of the way
+/// (3/4, then 1/2, in D), which still lowers the tip's distance. A tip is judged by its distance to the level as it is
 /// when its turn comes, after the snaps before it. Snaps cost triangle quality, so only tips
 /// that set the Hausdorff distance are tried, and all snaps are undone unless together they
 /// lower the largest input-to-level distance.
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "mesh/trimesh.h"
@@ -35,17 +38,20 @@ struct FeatureSnapOptions {
 
 /// What the snap asks of the parameter domain, which holds a point of D per level vertex.
 struct SnapInDomain {
-  std::function<bool(int v, int s)> allowed;  ///< v at input vertex s's point of D flips none of its triangles there
-  std::function<void(int v, int s)> apply;    ///< puts v at s's point of D
-  std::function<void()> undo;                 ///< puts every vertex back where it was before the snap
+  /// v moved the fraction t (in (0, 1]) of the way to input vertex s's point of D: its 3D
+  /// position there on the input (at t = 1 exactly s's vertex), or nullopt where that point is
+  /// not in D or flips one of v's triangles.
+  std::function<std::optional<Eigen::Vector3d>(int v, int s, double t)> toward;
+  std::function<void(int v, int s, double t)> apply;  ///< puts v there in D
+  std::function<void()> undo;                         ///< puts every vertex back where it was before the snap
 };
 
 /// The snap in any parameter domain: level (X, F), input vertices surface_V with faces input_F;
 /// level vertices on `rim` stay, input vertices on `input_rim` are no tips.
 /// \pre as snap_to_input_tips(), in `domain`; rim has one entry per row of X, input_rim one per
 ///      row of surface_V.
-/// \post as snap_to_input_tips(): every moved vertex is exactly its input vertex in X and at
-///       its point of D; if the snaps are not kept, X and the domain are as they were.
+/// \post as snap_to_input_tips(): every moved vertex is at domain.toward()'s position in X and
+///       was applied in D; if the snaps are not kept, X and the domain are as they were.
 /// \throw nothing beyond std::bad_alloc and what `domain`'s functions throw.
 int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMatrixX3d& surface_V,
                              const RowMatrixX3i& input_F, const std::vector<bool>& rim,
@@ -55,7 +61,8 @@ int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMa
 /// Snaps vertices of (U, F) (lifted X) onto the input vertices farthest from (X, F).
 /// \pre X = lift of U onto the surface whose domain mesh is `param` (3D positions surface_V);
 ///      no triangle of (U, F) flipped in D; hints has one face of `param` per vertex.
-/// \post no triangle flipped in D; every moved vertex is exactly an input vertex (U and X);
+/// \post no triangle flipped in D; every moved vertex is on the input (X is the lift of U),
+///       exactly at an input vertex where it went the whole way;
 ///       if any moved, the largest distance from the input vertices to the level went down
 ///       by at least min_gain (else nothing moved: U, X and hints are as they were);
 ///       disk rim vertices do not move; if `snapped` is given it has one entry per vertex, true

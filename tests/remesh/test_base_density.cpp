@@ -145,8 +145,9 @@ TEST(TriangleRepair, ProjectsItsMovesOntoTheOriginalInput) {
 }
 
 // Tip snapping: on a coarse even layout of the ellipsoid, whose long-axis ends it cuts off,
-// vertices snap exactly onto input vertices, the largest input-to-level distance goes down,
-// nothing flips, and every snapped vertex's triangles keep the quality and angle bounds.
+// vertices snap onto input vertices (or part of the way, on the input), the largest
+// input-to-level distance goes down, nothing flips, and every snapped vertex's triangles keep
+// the quality and angle bounds.
 TEST(FeatureSnap, SnapsVerticesOntoTheTipsTheLevelCutsOff) {
   EllipsoidLayout layout(2);
   const Parameterization& param = layout.param;
@@ -165,15 +166,15 @@ TEST(FeatureSnap, SnapsVerticesOntoTheTipsTheLevelCutsOff) {
   EXPECT_LT(after, before);
   std::vector<int> fresh(U.rows(), 0);
   EXPECT_LT((lift_to_surface(domain, param.surface.V, U, fresh) - X).cwiseAbs().maxCoeff(), 1e-9);
-  int moved = 0;
+  int moved = 0, whole_way = 0;
   for (int v = 0; v < X.rows(); ++v) {
     if (X.row(v) == X0.row(v)) continue;
     ++moved;
-    // Exactly an input vertex.
+    // Exactly an input vertex, or part of the way there on the input (X is U's lift, above).
     double nearest = std::numeric_limits<double>::infinity();
     for (int s = 0; s < param.surface.num_vertices(); ++s)
       nearest = std::min(nearest, (param.surface.V.row(s) - X.row(v)).norm());
-    EXPECT_EQ(nearest, 0.0);
+    if (nearest == 0.0) ++whole_way;
     for (int f = 0; f < F.rows(); ++f) {
       if (F(f, 0) != v && F(f, 1) != v && F(f, 2) != v) continue;
       const QualityReport q = mesh_quality(TriMesh{X, RowMatrixX3i(F.row(f))});
@@ -182,65 +183,101 @@ TEST(FeatureSnap, SnapsVerticesOntoTheTipsTheLevelCutsOff) {
     }
   }
   EXPECT_EQ(moved, snaps);
+  std::printf("%d snaps, %d the whole way\n", snaps, whole_way);
 }
 
-// A tip whose nearest level vertex cannot take it (a neighbour pulled in makes that vertex's
-// triangles too thin there) is snapped by the next corner of its face that can: a flat
-// triangle grid, and an input that is the same grid with one spike.
-TEST(FeatureSnap, ATipTheNearestCornerCannotTakeGoesToTheNextCorner) {
-  const int n = 7;
-  const auto at = [&](int i, int j) { return j * n + i; };
-  RowMatrixX3d X(n * n, 3);
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) X.row(at(i, j)) << i + 0.5 * j, j * std::sqrt(3.0) / 2, 0;
-  std::vector<Eigen::RowVector3i> faces;
-  for (int j = 0; j + 1 < n; ++j)
-    for (int i = 0; i + 1 < n; ++i) {
-      faces.emplace_back(at(i, j), at(i + 1, j), at(i, j + 1));
-      faces.emplace_back(at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+// A flat triangle grid (the level, 7 x 7 vertices, unit edges) and an input that is the same
+// grid with a spike: the face (nearest, next, third) replaced by three faces to a tip above it.
+// D is the plane the grid lies in.
+struct SpikedGrid {
+  static constexpr int n = 7;
+  static int at(int i, int j) { return j * n + i; }
+  const int nearest = at(3, 3), next = at(4, 3), third = at(3, 4), tip_vertex = n * n;
+  RowMatrixX3d X, input_V;
+  RowMatrixX3i F, input_F;
+
+  // `pulled` moves a neighbour of `nearest` (only) toward the tip's side first.
+  SpikedGrid(const Eigen::RowVector3d& tip, bool pulled) : X(n * n, 3), input_V(n * n + 1, 3) {
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) X.row(at(i, j)) << i + 0.5 * j, j * std::sqrt(3.0) / 2, 0;
+    if (pulled) X.row(at(3, 2)) << 4.45, 1.376, 0;
+    std::vector<Eigen::RowVector3i> faces;
+    for (int j = 0; j + 1 < n; ++j)
+      for (int i = 0; i + 1 < n; ++i) {
+        faces.emplace_back(at(i, j), at(i + 1, j), at(i, j + 1));
+        faces.emplace_back(at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+      }
+    F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+    input_F.resize(F.rows() + 2, 3);
+    int rows = 0;
+    for (std::size_t f = 0; f < faces.size(); ++f) {
+      F.row(static_cast<Eigen::Index>(f)) = faces[f];
+      if (faces[f] != Eigen::RowVector3i(nearest, next, third)) input_F.row(rows++) = faces[f];
     }
-  const int nearest = at(3, 3), next = at(4, 3), third = at(3, 4);
-  X.row(at(3, 2)) << 4.45, 1.376, 0;                  // a neighbour of `nearest` only, pulled toward the tip's side
-  const Eigen::RowVector3d tip(4.937, 2.726, 0.454);  // above the face (nearest, next, third)
-  RowMatrixX3i F(static_cast<Eigen::Index>(faces.size()), 3), input_F(F.rows() + 2, 3);
-  int rows = 0;
-  for (std::size_t f = 0; f < faces.size(); ++f) {
-    F.row(static_cast<Eigen::Index>(f)) = faces[f];
-    if (faces[f] != Eigen::RowVector3i(nearest, next, third)) input_F.row(rows++) = faces[f];
+    input_F.row(rows++) << nearest, next, tip_vertex;
+    input_F.row(rows++) << next, third, tip_vertex;
+    input_F.row(rows++) << third, nearest, tip_vertex;
+    input_V << X, tip;
   }
-  ASSERT_EQ(rows, F.rows() - 1);
-  RowMatrixX3d input_V(n * n + 1, 3);
-  input_V << X, tip;
-  const int s = n * n;
-  input_F.row(rows++) << nearest, next, s;
-  input_F.row(rows++) << next, third, s;
-  input_F.row(rows++) << third, nearest, s;
-  // The nearest corner's triangles with it on the tip are below the bounds; the next corner's are not.
-  const VertexStars stars(F, n * n);
-  FeatureSnapOptions options;
-  const auto star_bounds_hold = [&](int v) {
+
+  // Whether v's triangles, v at x, keep the snap's bounds.
+  bool bounds_hold(int v, const Eigen::RowVector3d& x, const FeatureSnapOptions& options) const {
+    const VertexStars stars(F, n * n);
     RowMatrixX3d moved = X;
-    moved.row(v) = tip;
+    moved.row(v) = x;
     for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) {
       const QualityReport q = mesh_quality(TriMesh{moved, RowMatrixX3i(F.row(stars.faces[i]))});
       if (q.q_min < options.min_quality || q.min_angle_deg < options.min_angle_deg) return false;
     }
     return true;
-  };
-  ASSERT_LT((X.row(nearest) - tip).head<2>().norm(), (X.row(next) - tip).head<2>().norm());
-  ASSERT_FALSE(star_bounds_hold(nearest));
-  ASSERT_TRUE(star_bounds_hold(next));
+  }
 
-  const RowMatrixX3d X0 = X;
-  const SnapInDomain domain{[](int, int) { return true; }, [](int, int) {}, [] {}};
-  std::vector<bool> snapped;
-  const int snaps = snap_level_to_input_tips(F, X, input_V, input_F, boundary_vertices(F, n * n),
-                                             boundary_vertices(input_F, n * n + 1), domain, options, &snapped);
+  // The snap, with v moved the fraction t of the way in the plane; the snapped mask.
+  std::pair<int, std::vector<bool>> snap(const FeatureSnapOptions& options) {
+    const SnapInDomain flat{[&](int v, int s, double t) -> std::optional<Eigen::Vector3d> {
+                              return Eigen::Vector3d(((1 - t) * X.row(v) + t * input_V.row(s)).transpose());
+                            },
+                            [](int, int, double) {}, [] {}};
+    std::vector<bool> snapped;
+    const int snaps = snap_level_to_input_tips(F, X, input_V, input_F, boundary_vertices(F, n * n),
+                                               boundary_vertices(input_F, n * n + 1), flat, options, &snapped);
+    return {snaps, snapped};
+  }
+};
+
+// A tip whose nearest level vertex cannot take it (a neighbour pulled in makes that vertex's
+// triangles too thin there) is snapped by the next corner of its face that can.
+TEST(FeatureSnap, ATipTheNearestCornerCannotTakeGoesToTheNextCorner) {
+  const Eigen::RowVector3d tip(4.937, 2.726, 0.454);  // above the face (nearest, next, third)
+  SpikedGrid g(tip, true);
+  const FeatureSnapOptions options;
+  ASSERT_LT((g.X.row(g.nearest) - tip).head<2>().norm(), (g.X.row(g.next) - tip).head<2>().norm());
+  ASSERT_FALSE(g.bounds_hold(g.nearest, tip, options));
+  ASSERT_TRUE(g.bounds_hold(g.next, tip, options));
+  const RowMatrixX3d X0 = g.X;
+  const auto [snaps, snapped] = g.snap(options);
   ASSERT_EQ(snaps, 1);
-  EXPECT_TRUE(snapped[next]);
-  EXPECT_TRUE(X.row(next) == tip);
-  for (int v = 0; v < n * n; ++v)
-    if (v != next) EXPECT_TRUE(X.row(v) == X0.row(v)) << v;
+  EXPECT_TRUE(snapped[g.next]);
+  EXPECT_TRUE(g.X.row(g.next) == tip);
+  for (int v = 0; v < g.X.rows(); ++v)
+    if (v != g.next) EXPECT_TRUE(g.X.row(v) == X0.row(v)) << v;
+}
+
+// A tip too high for any corner to take it the whole way is taken part of the way (3/4 here)
+// by the nearest corner that can: the tip comes closer to the level.
+TEST(FeatureSnap, ATipNoCornerCanTakeIsTakenPartOfTheWay) {
+  const Eigen::RowVector3d tip(4.9, 2.748, 1.3);
+  SpikedGrid g(tip, false);
+  const FeatureSnapOptions options;
+  for (int v : {g.nearest, g.next, g.third}) ASSERT_FALSE(g.bounds_hold(v, tip, options)) << v;
+  const Eigen::RowVector3d three_quarters = 0.25 * g.X.row(g.nearest) + 0.75 * tip;
+  ASSERT_TRUE(g.bounds_hold(g.nearest, three_quarters, options));
+  const double before = SurfaceLocator(TriMesh{g.X, g.F}).closest(tip.transpose()).distance;
+  const auto [snaps, snapped] = g.snap(options);
+  ASSERT_EQ(snaps, 1);
+  EXPECT_TRUE(snapped[g.nearest]);
+  EXPECT_TRUE(g.X.row(g.nearest) == three_quarters);
+  EXPECT_LT(SurfaceLocator(TriMesh{g.X, g.F}).closest(tip.transpose()).distance, 0.5 * before);
 }
 
 // A snap must bring the input around the vertex really closer to the level: asking for the
