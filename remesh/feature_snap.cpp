@@ -1,7 +1,5 @@
 #include "remesh/feature_snap.h"
 
-#include "remesh/lift.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -9,6 +7,7 @@
 
 #include "mesh/distance.h"
 #include "mesh/parallel.h"
+#include "remesh/lift.h"
 #include "remesh/surface_moves.h"
 
 namespace mrsnake {
