@@ -9,7 +9,8 @@
 /// its triangles' centroids: a Lloyd step on the surface itself, as in CGAL's tangential
 /// relaxation), the tangential part of that 3D move is pulled back to D through the Jacobian of
 /// the input triangle under the vertex, and the vertex is re-lifted. Moves that would flip a
-/// triangle in D are halved until they do not.
+/// triangle in D are halved until they do not. The two halves of the level are swept side by
+/// side, then the vertices along the cut (split_sweep.h).
 #include <optional>
 #include <vector>
 

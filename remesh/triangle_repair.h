@@ -11,7 +11,9 @@
 /// triangle under the vertex and re-lifted exactly (so the vertex stays on the input surface);
 /// the candidate that raises the smallest Q of the vertex's triangles the most is kept, and
 /// only if it raises it. Connectivity is untouched (the hierarchy stays nested) and a move that
-/// would flip a triangle in D is never taken. Disk rim vertices slide along the circle.
+/// would flip a triangle in D is never taken. Disk rim vertices slide along the circle. The two
+/// halves of the level are swept side by side, each worst first, then the vertices along the cut
+/// (split_sweep.h).
 #include <vector>
 
 #include "mesh/distance.h"
