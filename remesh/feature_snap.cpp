@@ -82,6 +82,10 @@ double star_smallest_angle(const RowMatrixX3d& X, const RowMatrixX3i& F, const V
   return smallest;
 }
 
+// The least part of the way to a tip that a snap moves a vertex: less cannot lower the tip's
+// distance by the quarter that the default min_gain asks.
+constexpr double kLeastFraction = 0.25;
+
 // What a snap of a level vertex onto a tip comes to.
 enum class SnapVerdict { take, refuse, tip_already_close };
 
@@ -212,15 +216,35 @@ int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMa
     if (!(region.error(v, *to) <= (1 - options.min_gain) * region.error(v, x_old))) return refuse;
     return {SnapVerdict::take, *to};
   };
+  // Whether v's triangles keep the bounds with v the fraction t of the way to s.
+  const auto bounds_hold = [&](int v, int s, double t) {
+    const std::optional<Eigen::Vector3d> to = domain.toward(v, s, t);
+    return to && star_quality(X, F, stars, v, *to) >= options.min_quality &&
+           star_smallest_angle(X, F, stars, v, *to) >= options.min_angle_deg;
+  };
+  // The largest fraction of the way to s, from 1/4, that v can go within the bounds (to 1/40
+  // of the way, by bisection; the bounds tighten as v goes), or 0 if not even 1/4.
+  const auto farthest_within_bounds = [&](int v, int s) {
+    if (moved[v] || rim[v] || !bounds_hold(v, s, kLeastFraction)) return 0.0;
+    double within = kLeastFraction, beyond = 1.0;
+    while (beyond - within > 0.025) {
+      const double t = 0.5 * (within + beyond);
+      (bounds_hold(v, s, t) ? within : beyond) = t;
+    }
+    return within;
+  };
   for (int s : far_tips(input, far_threshold, input_F, input_rim)) {
     if (snaps >= options.max_snaps || judged >= max_judged) break;
     const Eigen::Vector3d x = surface_V.row(s).transpose();
     // The nearest corner of the tip's nearest face that can take it (the nearest may be held by
-    // its triangles' quality where the next one is not), the whole way, else part of the way.
+    // its triangles' quality where the next one is not) the whole way, else the nearest that
+    // can go part of the way, as far as the bounds allow.
     const std::array<int, 3> corners = corners_nearest_first(X, F, input.nearest_face[s], x);
     bool done = false;
-    for (const double t : {1.0, 0.75, 0.5})
+    for (int phase = 0; phase < 2; ++phase)
       for (int k = 0; k < 3 && !done && judged < max_judged; ++k) {
+        const double t = phase == 0 ? 1.0 : farthest_within_bounds(corners[k], s);
+        if (!(t > 0)) continue;
         const Verdict verdict = judge_snap(corners[k], s, x, t);
         done = verdict.verdict != SnapVerdict::refuse;
         if (verdict.verdict != SnapVerdict::take) continue;

@@ -8,8 +8,9 @@
 /// vertex's triangles with Q >= min_quality and angles >= min_angle_deg, and really brings the
 /// input around the vertex closer to the level (moving a vertex onto a tip also moves its
 /// triangles off the input it stood on). Where the nearest vertex cannot take the tip, the
-/// other corners of the tip's nearest face are tried; where none can, the same part of the way
-/// (3/4, then 1/2, in D), which still lowers the tip's distance. A tip is judged by its distance to the level as it is
+/// other corners of the tip's nearest face are tried; where none can, the nearest corner that
+/// can go part of the way (from 1/4, in D) goes as far as the bounds allow, which still lowers
+/// the tip's distance. A tip is judged by its distance to the level as it is
 /// when its turn comes, after the snaps before it. Snaps cost triangle quality, so only tips
 /// that set the Hausdorff distance are tried, and all snaps are undone unless together they
 /// lower the largest input-to-level distance.

@@ -263,20 +263,25 @@ TEST(FeatureSnap, ATipTheNearestCornerCannotTakeGoesToTheNextCorner) {
     if (v != g.next) EXPECT_TRUE(g.X.row(v) == X0.row(v)) << v;
 }
 
-// A tip too high for any corner to take it the whole way is taken part of the way (3/4 here)
-// by the nearest corner that can: the tip comes closer to the level.
+// A tip too high for any corner to take it the whole way is taken part of the way, as far as
+// the bounds allow (to the bisection's 1/40), by the nearest corner: the tip comes closer.
 TEST(FeatureSnap, ATipNoCornerCanTakeIsTakenPartOfTheWay) {
   const Eigen::RowVector3d tip(4.9, 2.748, 1.3);
   SpikedGrid g(tip, false);
   const FeatureSnapOptions options;
   for (int v : {g.nearest, g.next, g.third}) ASSERT_FALSE(g.bounds_hold(v, tip, options)) << v;
-  const Eigen::RowVector3d three_quarters = 0.25 * g.X.row(g.nearest) + 0.75 * tip;
-  ASSERT_TRUE(g.bounds_hold(g.nearest, three_quarters, options));
+  const Eigen::RowVector3d start = g.X.row(g.nearest);
+  const auto part_of_the_way = [&](double t) { return Eigen::RowVector3d((1 - t) * start + t * tip); };
+  ASSERT_TRUE(g.bounds_hold(g.nearest, part_of_the_way(0.5), options));
   const double before = SurfaceLocator(TriMesh{g.X, g.F}).closest(tip.transpose()).distance;
   const auto [snaps, snapped] = g.snap(options);
   ASSERT_EQ(snaps, 1);
   EXPECT_TRUE(snapped[g.nearest]);
-  EXPECT_TRUE(g.X.row(g.nearest) == three_quarters);
+  const double t = g.X(g.nearest, 2) / tip.z();  // the grid is flat: the height tells the fraction
+  EXPECT_GE(t, 0.5);
+  EXPECT_LT((g.X.row(g.nearest) - part_of_the_way(t)).norm(), 1e-12);
+  EXPECT_TRUE(g.bounds_hold(g.nearest, part_of_the_way(t), options));
+  EXPECT_FALSE(g.bounds_hold(g.nearest, part_of_the_way(t + 0.025), options));
   EXPECT_LT(SurfaceLocator(TriMesh{g.X, g.F}).closest(tip.transpose()).distance, 0.5 * before);
 }
 
