@@ -1,8 +1,10 @@
 #include "remesh/feature_snap.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <utility>
 
 #include "mesh/distance.h"
@@ -194,6 +196,27 @@ int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMa
   const RowMatrixX3d X_before = X;
   int snaps = 0, judged = 0;
   const int max_judged = 8 * options.max_snaps;  // the region error is the costly part
+  // Where v goes, the fraction t of the way to input vertex s, if it may move there: in D, and
+  // with its triangles within the bounds.
+  const auto within_bounds = [&](int v, int s, double t) -> std::optional<Eigen::Vector3d> {
+    if (moved[v] || rim[v]) return std::nullopt;
+    const std::optional<Eigen::Vector3d> to = domain.toward(v, s, t);
+    if (!to || star_quality(X, F, stars, v, *to) < options.min_quality ||
+        star_smallest_angle(X, F, stars, v, *to) < options.min_angle_deg)
+      return std::nullopt;
+    return to;
+  };
+  // The largest fraction of the way to s, from 1/4, that v can go within the bounds (to 1/40
+  // of the way, by bisection; the bounds tighten as v goes), or 0 if not even 1/4.
+  const auto farthest_within_bounds = [&](int v, int s) {
+    if (!within_bounds(v, s, kLeastFraction)) return 0.0;
+    double within = kLeastFraction, beyond = 1.0;
+    while (beyond - within > 0.025) {
+      const double t = 0.5 * (within + beyond);
+      (within_bounds(v, s, t) ? within : beyond) = t;
+    }
+    return within;
+  };
   // Whether moving v the fraction t of the way to input vertex s (at x) is worth it, and where to.
   struct Verdict {
     SnapVerdict verdict;
@@ -206,32 +229,13 @@ int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMa
     region.collect(v);
     // An earlier snap nearby may have fixed this tip already: its distance now, not before.
     if (!(region.distance(x, v, x_old) > threshold)) return {SnapVerdict::tip_already_close, x_old};
-    const std::optional<Eigen::Vector3d> to = domain.toward(v, s, t);
-    if (!to || star_quality(X, F, stars, v, *to) < options.min_quality ||
-        star_smallest_angle(X, F, stars, v, *to) < options.min_angle_deg)
-      return refuse;
+    const std::optional<Eigen::Vector3d> to = within_bounds(v, s, t);
+    if (!to) return refuse;
     // Worth it only if the input around v ends up really closer to the level: moving v onto s
     // also moves its triangles away from the input v stood on.
     ++judged;
     if (!(region.error(v, *to) <= (1 - options.min_gain) * region.error(v, x_old))) return refuse;
     return {SnapVerdict::take, *to};
-  };
-  // Whether v's triangles keep the bounds with v the fraction t of the way to s.
-  const auto bounds_hold = [&](int v, int s, double t) {
-    const std::optional<Eigen::Vector3d> to = domain.toward(v, s, t);
-    return to && star_quality(X, F, stars, v, *to) >= options.min_quality &&
-           star_smallest_angle(X, F, stars, v, *to) >= options.min_angle_deg;
-  };
-  // The largest fraction of the way to s, from 1/4, that v can go within the bounds (to 1/40
-  // of the way, by bisection; the bounds tighten as v goes), or 0 if not even 1/4.
-  const auto farthest_within_bounds = [&](int v, int s) {
-    if (moved[v] || rim[v] || !bounds_hold(v, s, kLeastFraction)) return 0.0;
-    double within = kLeastFraction, beyond = 1.0;
-    while (beyond - within > 0.025) {
-      const double t = 0.5 * (within + beyond);
-      (bounds_hold(v, s, t) ? within : beyond) = t;
-    }
-    return within;
   };
   for (int s : far_tips(input, far_threshold, input_F, input_rim)) {
     if (snaps >= options.max_snaps || judged >= max_judged) break;

@@ -10,7 +10,6 @@
 /// can be swept side by side and each sees only its own moves. The vertices along the cut (the
 /// band) are swept afterwards, on one thread. Each half keeps its order, so the result is the
 /// same with one core as with two.
-#include <array>
 #include <vector>
 
 #include "mesh/parallel.h"
