@@ -16,6 +16,7 @@
 #include "mesh/quality.h"
 #include "mesh/vertex_stars.h"
 #include "remesh/domain.h"
+#include "remesh/split_sweep.h"
 #include "remesh/surface_moves.h"
 
 namespace mrsnake {
@@ -262,6 +263,18 @@ struct RepairCandidate {
   Eigen::Vector3d x;
 };
 
+// The triangles of (X, F) with Q below `threshold`, worst first, with their Q.
+std::vector<std::pair<double, int>> poor_faces(const RowMatrixX3d& X, const RowMatrixX3i& F, double threshold) {
+  std::vector<std::pair<double, int>> poor;
+  for (int f = 0; f < F.rows(); ++f)
+    if (const double q =
+            frey_borouchaki_quality(X.row(F(f, 0)).transpose(), X.row(F(f, 1)).transpose(), X.row(F(f, 2)).transpose());
+        q < threshold)
+      poor.emplace_back(q, f);
+  std::sort(poor.begin(), poor.end());
+  return poor;
+}
+
 // Vertex v of a poor triangle to the candidate (repair_targets() at full, half and quarter
 // steps) that raises the smallest Q of its triangles the most, if one does without adding a
 // flip in D and within the guard. Returns whether it moved.
@@ -321,34 +334,20 @@ BaseRepairStats repair_on_base(const RowMatrixX3i& F, const BaseDomain& domain, 
   const VertexStars stars(F, n);
   const std::vector<bool> rim = boundary_vertices(F, stars);
   const double mean_edge = mean_edge_length(layout.X, F);
+  const auto movable = [&](int v) { return !rim[v] && !(options.fixed && (*options.fixed)[v]); };
+  const SplitSweep split(layout.X, F, stars);
   BaseRepairStats stats;
   stats.q_min_before = smallest_quality(layout.X, F);
   std::vector<int> visited(n, -1);
   RepairRetries retries(F, stars, n);
   for (int sweep = 0; sweep < options.sweeps; ++sweep) {
-    std::vector<std::pair<double, int>> poor;
-    for (int f = 0; f < F.rows(); ++f)
-      if (const double q = frey_borouchaki_quality(layout.X.row(F(f, 0)).transpose(), layout.X.row(F(f, 1)).transpose(),
-                                                   layout.X.row(F(f, 2)).transpose());
-          q < options.threshold)
-        poor.emplace_back(q, f);
-    std::sort(poor.begin(), poor.end());
-    int moved = 0;
-    for (const auto& [q, f] : poor)
-      for (int k = 0; k < 3; ++k) {
-        const int v = F(f, k);
-        if (visited[v] == sweep || rim[v] || (options.fixed && (*options.fixed)[v])) continue;
-        visited[v] = sweep;
-        if (!retries.worth_trying(v)) continue;
-        if (repair_vertex(F, stars, domain, lift, options, mean_edge, v, layout)) {
-          retries.moved(v);
-          ++moved;
-        } else {
-          retries.failed(v);
-        }
-      }
-    stats.moves += moved;
-    if (moved == 0) break;
+    const std::vector<std::pair<double, int>> poor = poor_faces(layout.X, F, options.threshold);
+    if (poor.empty()) break;
+    const int moves = repair_sweep(split, F, poor, sweep, visited, retries, movable, [&](int v) {
+      return repair_vertex(F, stars, domain, lift, options, mean_edge, v, layout);
+    });
+    stats.moves += moves;
+    if (moves == 0) break;
   }
   stats.q_min_after = smallest_quality(layout.X, F);
   return stats;
@@ -437,16 +436,22 @@ int smooth_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLi
   const VertexStars stars(F, n);
   const std::vector<Eigen::Vector2i> rim = rim_neighbours(boundary_edges(F, stars), n);
   const bool weighted = options.target == SmoothingTarget::area_centroid && options.surface_density;
+  // Each move reads v's 1-ring and star and writes v only, as SplitSweep::run asks.
+  const auto smooth_vertex = [&](const Eigen::VectorXd& density, int v) {
+    const bool on_rim = rim[v][0] >= 0 || rim[v][1] >= 0;
+    return on_rim ? options.slide_rim && slide_rim_vertex(F, stars, domain, lift, options, rim[v], v, layout)
+                  : move_vertex(F, stars, domain, lift, options, density, v, layout);
+  };
+  const SplitSweep split(layout.X, F, stars);
   int moves = 0;
   for (int it = 0; it < options.iterations; ++it) {
     const Eigen::VectorXd density = density_under(lift, layout, weighted ? options.surface_density : nullptr);
-    for (int v = 0; v < n; ++v) {
-      const bool on_rim = rim[v][0] >= 0 || rim[v][1] >= 0;
-      const bool moved = on_rim
-                             ? options.slide_rim && slide_rim_vertex(F, stars, domain, lift, options, rim[v], v, layout)
-                             : move_vertex(F, stars, domain, lift, options, density, v, layout);
-      if (moved) ++moves;
-    }
+    std::array<int, SplitSweep::kParts> moved{};
+    split.run([&](int part) {
+      for (int v = 0; v < n; ++v)
+        if (split.part(v) == part && smooth_vertex(density, v)) ++moved[part];
+    });
+    moves += moved[0] + moved[1] + moved[2];
   }
   return moves;
 }

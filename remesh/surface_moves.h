@@ -4,13 +4,14 @@
 /// 3D and carry each move back to the parameter domain D (shape_smoothing.h, triangle_repair.h,
 /// base_levels.h): the vertex normal, the no-flip check of a vertex's star in D, the smallest
 /// quality of a star and of a level, the mean edge length, the point-triangle distance, the
-/// equilateral apex of an edge, the repair's surface error, targets and retries, and the
+/// equilateral apex of an edge, the repair's surface error, targets, retries and sweep, and the
 /// pull-back of a 3D move through the affine map of one input triangle.
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -20,6 +21,7 @@
 #include "mesh/trimesh.h"
 #include "mesh/vertex_stars.h"
 #include "remesh/domain.h"
+#include "remesh/split_sweep.h"
 
 namespace mrsnake {
 
@@ -218,6 +220,36 @@ class RepairRetries {
   std::array<long, 3> clock_{};
   std::vector<long> moved_at_, failed_at_;
 };
+
+/// One repair sweep over the vertices of the `poor` faces (worst first), on the parts of
+/// `split`: each part visits its own vertices in that order, each vertex once per sweep
+/// (`visited` stamped with `sweep`), movable(v) and worth retrying, and repair(v) moves it or
+/// not. \return the moves made.
+/// \pre repair(v) reads only v's 1-ring and star and writes only v (SplitSweep::run).
+template <class Movable, class RepairVertex>
+int repair_sweep(const SplitSweep& split, const RowMatrixX3i& F, const std::vector<std::pair<double, int>>& poor,
+                 int sweep, std::vector<int>& visited, RepairRetries& retries, Movable&& movable,
+                 RepairVertex&& repair) {
+  std::array<int, SplitSweep::kParts> moved{};
+  split.run([&](int part) {
+    if (part == SplitSweep::kBand) retries.join_parts();
+    for (const auto& [q_face, face] : poor)
+      for (int corner = 0; corner < 3; ++corner) {
+        const int v = F(face, corner);
+        if (split.part(v) != part || visited[v] == sweep || !movable(v)) continue;
+        visited[v] = sweep;
+        if (!retries.worth_trying(v)) continue;
+        if (repair(v)) {
+          retries.moved(v, part);
+          ++moved[part];
+        } else {
+          retries.failed(v, part);
+        }
+      }
+  });
+  retries.join_parts();
+  return moved[0] + moved[1] + moved[2];
+}
 
 /// The affine map of one input triangle from its plane in 3D to D. A 3D move is projected on
 /// the triangle's plane (least squares) and mapped to the move in D that gives it, to first

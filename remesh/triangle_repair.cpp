@@ -175,26 +175,9 @@ TriangleRepairStats repair_worst_triangles(DomainKind kind, const RowMatrixX3i& 
   for (int sweep = 0; sweep < options.sweeps; ++sweep) {
     const std::vector<std::pair<double, int>> poor = repair.poor_faces();
     if (poor.empty()) break;
-    // Each part visits its vertices of the poor faces, worst face first.
-    std::array<int, SplitSweep::kParts> moved{};
-    split.run([&](int part) {
-      if (part == SplitSweep::kBand) retries.join_parts();
-      for (const auto& [q_face, face] : poor)
-        for (int corner = 0; corner < 3; ++corner) {
-          const int v = F(face, corner);
-          if (split.part(v) != part || visited[v] == sweep || !repair.movable(v)) continue;
-          visited[v] = sweep;
-          if (!retries.worth_trying(v)) continue;
-          if (repair.repair_vertex(v)) {
-            retries.moved(v, part);
-            ++moved[part];
-          } else {
-            retries.failed(v, part);
-          }
-        }
-    });
-    retries.join_parts();
-    const int moves = moved[0] + moved[1] + moved[2];
+    const int moves = repair_sweep(
+        split, F, poor, sweep, visited, retries, [&](int v) { return repair.movable(v); },
+        [&](int v) { return repair.repair_vertex(v); });
     stats.moves += moves;
     if (moves == 0) break;
   }
