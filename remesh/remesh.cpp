@@ -452,12 +452,20 @@ class BaseRouteBeside {
   void start() {
     if (running_.valid()) return;
     try {
-      running_ = std::async(std::launch::async, [this] { return run(); });
+      running_ = std::async(std::launch::async, [this] {
+        const ThreadAtWork at_work;  // beside the sphere route: the two fill two cores
+        return run();
+      });
     } catch (...) {  // std::system_error (no thread) or std::bad_alloc
     }
   }
 
-  BaseOutcome outcome() { return running_.valid() ? running_.get() : run(); }
+  // The route's outcome; the calling thread leaves its core to the route while it waits.
+  BaseOutcome outcome() {
+    if (!running_.valid()) return run();
+    const ThreadWaiting waiting;
+    return running_.get();
+  }
 
  private:
   BaseOutcome run() const {

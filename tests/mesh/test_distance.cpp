@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 #include <system_error>
 #include <thread>
@@ -178,6 +180,56 @@ TEST(ParallelRanges, RunBothRunsBothAndRethrowsAFirst) {
   }
   EXPECT_EQ(ran.load(), 2);
   EXPECT_THROW(run_both_in_parallel([] {}, [] { throw std::logic_error("b"); }), std::logic_error);
+}
+
+// Counts one thread at work per core but `spare` (the test's own thread is one).
+std::vector<std::unique_ptr<ThreadAtWork>> fill_cores_but(int spare) {
+  std::vector<std::unique_ptr<ThreadAtWork>> fill;
+  for (int i = 1 + spare; i < static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); ++i)
+    fill.push_back(std::make_unique<ThreadAtWork>());
+  return fill;
+}
+
+// A helper starts a thread only on an idle core: where the cores are at work (the remesher's
+// two domains side by side), a nested sweep runs its parts one after the other.
+TEST(ParallelRanges, ThreadsStartOnlyOnIdleCores) {
+  const std::thread::id caller = std::this_thread::get_id();
+  {
+    const auto fill = fill_cores_but(0);
+    std::thread::id ran_b;
+    run_both_in_parallel([] {}, [&] { ran_b = std::this_thread::get_id(); });
+    EXPECT_EQ(ran_b, caller);
+    std::atomic<int> elsewhere{0};
+    parallel_ranges(
+        64, [&](std::size_t, std::size_t) { elsewhere += std::this_thread::get_id() != caller; }, 1);
+    EXPECT_EQ(elsewhere.load(), 0);
+    EXPECT_FALSE(claim_idle_core());
+  }
+  if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "one core: every job runs on the calling thread";
+  std::thread::id ran_b;
+  run_both_in_parallel([] {}, [&] { ran_b = std::this_thread::get_id(); });
+  EXPECT_NE(ran_b, caller);
+}
+
+// A thread that waits for another to end leaves its core: with a() done at once, the caller
+// waits for b(), and a job nested in b() finds that core idle.
+TEST(ParallelRanges, AThreadWaitingForAnotherLeavesItsCore) {
+  if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "one core: b() runs on the calling thread";
+  const auto fill = fill_cores_but(1);  // the caller and b() take the last two
+  bool found_idle = false;
+  run_both_in_parallel([] {},
+                       [&] {
+                         for (int tries = 0; tries < 5000 && !found_idle; ++tries)
+                           if (claim_idle_core()) {
+                             found_idle = true;
+                             release_core();
+                           } else {
+                             std::this_thread::sleep_for(std::chrono::milliseconds(1));
+                           }
+                       });
+  EXPECT_TRUE(found_idle);
+  EXPECT_TRUE(claim_idle_core());  // every claim was released
+  release_core();
 }
 
 TEST(SurfaceDistance, MeshAgainstItselfIsZero) {
