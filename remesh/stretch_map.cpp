@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "mesh/errors.h"
+#include "mesh/vertex_stars.h"
+#include "remesh/split_sweep.h"
 
 namespace mrsnake {
 namespace {
@@ -177,15 +179,14 @@ class StarRelaxer {
   mutable std::vector<Cached> surface_;  // a cache: star_energy stays const
 };
 
-/// Sweeps over `vertices` until one lowers the energy by less than `tolerance` (relative) or
+/// Sweeps (sweep_once()) until one lowers the energy by less than `tolerance` (relative) or
 /// `max_sweeps` are done. \return the sweeps made.
-template <class EnergyFn>
-int sweep_until_converged(StarRelaxer& relaxer, const std::vector<int>& vertices, int max_sweeps, double tolerance,
-                          EnergyFn&& total_energy) {
+template <class SweepFn, class EnergyFn>
+int sweep_until_converged(SweepFn&& sweep_once, int max_sweeps, double tolerance, EnergyFn&& total_energy) {
   double before = total_energy();
   int sweeps = 0;
   while (sweeps < max_sweeps) {
-    for (int v : vertices) relaxer.relax(v);
+    sweep_once();
     ++sweeps;
     const double after = total_energy();
     if (!(before - after > tolerance * before)) break;
@@ -434,11 +435,24 @@ RowMatrixX3d hierarchical_sphere_map(const TriMesh& mesh, const HierarchicalMapO
     relaxer.relax(c->removed);
     present.push_back(c->removed);
     if (present.size() >= next_round) {
-      sweep_until_converged(relaxer, present, options.level_sweeps, options.tolerance, present_energy);
+      const auto sweep_present = [&] {
+        for (int v : present) relaxer.relax(v);
+      };
+      sweep_until_converged(sweep_present, options.level_sweeps, options.tolerance, present_energy);
       next_round = present.size() * options.growth;
     }
   }
-  sweep_until_converged(relaxer, present, options.final_sweeps, options.tolerance, present_energy);
+  // The final sweeps, over the whole mesh, relax the two halves side by side (split_sweep.h):
+  // a relaxation reads v's star and writes v and its star's cached surface triangles only.
+  const VertexStars stars(collapsible.F, n);
+  const SplitSweep split(mesh.V, collapsible.F, stars);
+  const auto sweep_halves = [&] {
+    split.run([&](int part) {
+      for (int v : present)
+        if (split.part(v) == part) relaxer.relax(v);
+    });
+  };
+  sweep_until_converged(sweep_halves, options.final_sweeps, options.tolerance, present_energy);
   return D;
 }
 
