@@ -604,7 +604,8 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["fit_rounds"] = options.relax == RelaxMode::all_vertices ? options.fit.rounds : 0;
   j["base_density_smoothing"] = options.base.density_smoothing;
   j["max_base_bend"] = options.base.max_bend;
-  j["lloyd_iterations"] = options.relaxation.lloyd_iterations;
+  // The base-mesh domain has no Lloyd step in D (it relaxes by shape smoothing and area centroids).
+  j["lloyd_iterations"] = result.domain == "base_mesh" ? 0 : options.relaxation.lloyd_iterations;
   j["shape_iterations"] = options.relax == RelaxMode::all_vertices ? options.relaxation.shape_iterations : 0;
   j["repair_sweeps"] = options.relax == RelaxMode::all_vertices ? options.repair.sweeps : 0;
   j["repair_threshold"] = options.repair.threshold;

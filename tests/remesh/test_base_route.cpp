@@ -68,6 +68,10 @@ TEST(BaseDomainRemesh, ALongCapsuleNestsUnflippedAndWellShaped) {
   const nlohmann::json q = mesh_quality(r.mesh(r.connectivity.levels()));
   EXPECT_GT(q["q_mean"].get<double>(), 0.85) << q.dump();
   EXPECT_GT(q["min_angle_deg"].get<double>(), 20.0) << q.dump();
+  // The report's summary names the steps that ran: the base mesh has no Lloyd step in D.
+  const nlohmann::json report = remesh_report(r, base_domain_options(4000));
+  EXPECT_EQ(report["lloyd_iterations"], 0);
+  EXPECT_EQ(report["options"]["relaxation"]["lloyd_iterations"], 8);  // the run, to repeat it
 }
 
 TEST(BaseDomainRemesh, ACoarseInputIsSplitFlatSoTheFinestLevelsTrianglesHoldTheirShape) {
