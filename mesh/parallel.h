@@ -29,7 +29,11 @@ inline std::atomic<int>& threads_at_work() {
   return count;
 }
 
-inline int core_count() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
+/// The machine's cores, asked once: every claim compares against it.
+inline int core_count() {
+  static const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return cores;
+}
 
 }  // namespace detail
 
@@ -134,7 +138,7 @@ void parallel_ranges_with(std::size_t n, std::size_t parts, F& f, StartThread&& 
 /// \pre f may run concurrently on disjoint ranges.
 template <class F>
 void parallel_ranges(std::size_t n, F&& f, std::size_t min_per_thread = 1024, std::size_t max_threads = 8) {
-  const std::size_t hardware = std::max<std::size_t>(1, std::thread::hardware_concurrency());
+  const auto hardware = static_cast<std::size_t>(detail::core_count());
   const std::size_t parts =
       std::max<std::size_t>(1, std::min({hardware, max_threads, n / std::max<std::size_t>(1, min_per_thread)}));
   detail::parallel_ranges_with(n, parts, f, [](auto&& job) { return detail::start_on_idle_core(std::move(job)); });

@@ -265,14 +265,11 @@ struct RepairCandidate {
 
 // The triangles of (X, F) with Q below `threshold`, worst first, with their Q.
 std::vector<std::pair<double, int>> poor_faces(const RowMatrixX3d& X, const RowMatrixX3i& F, double threshold) {
-  std::vector<std::pair<double, int>> poor;
+  std::vector<double> quality(static_cast<std::size_t>(F.rows()));
   for (int f = 0; f < F.rows(); ++f)
-    if (const double q =
-            frey_borouchaki_quality(X.row(F(f, 0)).transpose(), X.row(F(f, 1)).transpose(), X.row(F(f, 2)).transpose());
-        q < threshold)
-      poor.emplace_back(q, f);
-  std::sort(poor.begin(), poor.end());
-  return poor;
+    quality[f] =
+        frey_borouchaki_quality(X.row(F(f, 0)).transpose(), X.row(F(f, 1)).transpose(), X.row(F(f, 2)).transpose());
+  return faces_below(quality, threshold);
 }
 
 // Vertex v of a poor triangle to the candidate (repair_targets() at full, half and quarter

@@ -221,6 +221,16 @@ class RepairRetries {
   std::vector<long> moved_at_, failed_at_;
 };
 
+/// The faces whose quality (one entry per face) is below `threshold`, worst first, with their
+/// quality: what a repair sweep visits.
+inline std::vector<std::pair<double, int>> faces_below(const std::vector<double>& quality, double threshold) {
+  std::vector<std::pair<double, int>> poor;
+  for (int f = 0; f < static_cast<int>(quality.size()); ++f)
+    if (quality[f] < threshold) poor.emplace_back(quality[f], f);
+  std::sort(poor.begin(), poor.end());
+  return poor;
+}
+
 /// One repair sweep over the vertices of the `poor` faces (worst first), on the parts of
 /// `split`: each part visits its own vertices in that order, each vertex once per sweep
 /// (`visited` stamped with `sweep`), movable(v) and worth retrying, and repair(v) moves it or

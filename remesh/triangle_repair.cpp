@@ -54,13 +54,7 @@ class Repair {
   }
 
   // The faces below the threshold, worst first.
-  std::vector<std::pair<double, int>> poor_faces() const {
-    std::vector<std::pair<double, int>> poor;
-    for (int f = 0; f < static_cast<int>(face_quality_.size()); ++f)
-      if (face_quality_[f] < options_.threshold) poor.emplace_back(face_quality_[f], f);
-    std::sort(poor.begin(), poor.end());
-    return poor;
-  }
+  std::vector<std::pair<double, int>> poor_faces() const { return faces_below(face_quality_, options_.threshold); }
 
   // Whether v may move at all: not a fixed vertex, nor a rim vertex when the rim stays.
   bool movable(int v) const {
