@@ -68,8 +68,10 @@ touch "$work/mark3"
 sleep 1
 # Another reference, not merely a touched one (Snakemake compares the content of inputs under 100 kB).
 "$MRSNAKE_BIN" -q synth --shape ellipsoid --size 48 --snr 6 --seed 6 -o "$work/reference"
+# One job at a time and at most one started per second: a segmentation takes well under a
+# second here, and the whole run would otherwise end before the kill below.
 set -m  # the run in a process group of its own, whose id is its pid: killed whole, waited for
-"$root/scripts/study" "$work/study.yaml" >"$work/killed.log" 2>&1 &
+"$root/scripts/study" "$work/study.yaml" --cores 1 --max-jobs-per-second 1 >"$work/killed.log" 2>&1 &
 run=$!
 set +m
 for _ in $(seq 1 1200); do  # at most 120 s for the model and two segmentations (not the corrupt file's)
