@@ -5,6 +5,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <set>
 
 #include "mesh/errors.h"
@@ -12,6 +13,8 @@
 
 namespace mrsnake {
 namespace {
+
+constexpr double kPi = 3.14159265358979323846;
 
 // The valence flips never leave an interior vertex with fewer edges. One with three keeps three
 // triangles at every level of the 1:4 split, whose angles there sum to 360° on a flat patch:
@@ -40,8 +43,22 @@ void farthest_points(const RowMatrixX3d& X, const std::vector<int>& candidates, 
   }
 }
 
+// Which edges of a closed base are flipped toward the surface's Delaunay triangulation, if any.
+// The hierarchical map's: every edge past 180°, as far as each end keeps three edges (a margin
+// there measured worse: cheburashka at 16k faces, smallest angle 17.4° -> 11.3°). A one-chart
+// map's: those past 180° + one_chart_margin_deg, as far as each end keeps five edges; a base
+// vertex left with four has a right angle in its triangles at every level, which the repair
+// cannot raise (an ellipsoid with 24 base vertices: Q min 0.69 at the finest level against
+// 0.71 with the floor of five).
+std::optional<SurfaceFlipOptions> closed_base_flips(const Parameterization& param, double one_chart_margin_deg) {
+  if (param.kind != DomainKind::sphere) return std::nullopt;
+  if (param.sphere_map == SphereMap::hierarchical) return SurfaceFlipOptions{};
+  if (one_chart_margin_deg >= 180.0) return std::nullopt;
+  return SurfaceFlipOptions{one_chart_margin_deg * kPi / 180.0, 5};
+}
+
 void triangulate_samples(const Parameterization& param, const std::vector<bool>& boundary, int rim_min_triangles,
-                         BaseMesh& base) {
+                         double one_chart_margin_deg, BaseMesh& base) {
   const int m = static_cast<int>(base.samples.size());
   base.domain.resize(m, 3);
   for (int i = 0; i < m; ++i) base.domain.row(i) = param.domain.row(base.samples[i]);
@@ -71,10 +88,10 @@ void triangulate_samples(const Parameterization& param, const std::vector<bool>&
                          Remedy::other_resolution);
   if (const int flipped = count_flipped(base.domain, base.faces); flipped > 0)
     throw AlgorithmError("the base mesh has " + std::to_string(flipped) + " flipped triangles in the domain");
-  if (param.sphere_map == SphereMap::hierarchical) {
+  if (const std::optional<SurfaceFlipOptions> flips = closed_base_flips(param, one_chart_margin_deg)) {
     RowMatrixX3d X(m, 3);
     for (int i = 0; i < m; ++i) X.row(i) = param.surface.V.row(base.samples[i]);
-    base.surface_flips += flip_toward_surface_delaunay(base.domain, X, base.faces);
+    base.surface_flips += flip_toward_surface_delaunay(base.domain, X, base.faces, *flips);
   }
   base.valence_flips += flip_toward_regular_valence(base.domain, base.faces, rim_min_triangles);
 }
@@ -101,15 +118,17 @@ bool flip_if_allowed(const EdgeFlip& e, const FlipGuard& allowed, RowMatrixX3i& 
 
 }  // namespace
 
-int flip_toward_surface_delaunay(const RowMatrixX3d& D, const RowMatrixX3d& X, RowMatrixX3i& F) {
-  return flip_toward_surface_delaunay(X, F, convex_in_domain(D));
+int flip_toward_surface_delaunay(const RowMatrixX3d& D, const RowMatrixX3d& X, RowMatrixX3i& F,
+                                 const SurfaceFlipOptions& options) {
+  return flip_toward_surface_delaunay(X, F, convex_in_domain(D), options);
 }
 
 int flip_toward_regular_valence(const RowMatrixX3d& D, RowMatrixX3i& F, int rim_min_triangles) {
   return flip_toward_regular_valence(static_cast<int>(D.rows()), F, rim_min_triangles, convex_in_domain(D));
 }
 
-int flip_toward_surface_delaunay(const RowMatrixX3d& X, RowMatrixX3i& F, const FlipGuard& allowed) {
+int flip_toward_surface_delaunay(const RowMatrixX3d& X, RowMatrixX3i& F, const FlipGuard& allowed,
+                                 const SurfaceFlipOptions& options) {
   const auto angle_at = [&](int apex, int a, int b) {
     const Eigen::Vector3d u = X.row(a) - X.row(apex), w = X.row(b) - X.row(apex);
     return std::atan2(u.cross(w).norm(), u.dot(w));
@@ -132,10 +151,11 @@ int flip_toward_surface_delaunay(const RowMatrixX3d& X, RowMatrixX3i& F, const F
       if (touched[f1] || touched[f2]) continue;
       const int c = F(f1, fc.second), d = F(f2, twin->second.second);
       if (c == d || edge_faces.count({c, d}) || edge_faces.count({d, c}) ||
-          created.count({std::min(c, d), std::max(c, d)}) || valence[a] <= 3 || valence[b] <= 3)
+          created.count({std::min(c, d), std::max(c, d)}) || valence[a] <= options.min_end_edges ||
+          valence[b] <= options.min_end_edges)
         continue;
       // The surface's Delaunay condition: the two angles facing the edge sum to at most pi.
-      if (!(angle_at(c, a, b) + angle_at(d, b, a) > 3.14159265358979323846 + 1e-9)) continue;
+      if (!(angle_at(c, a, b) + angle_at(d, b, a) > kPi + options.margin + 1e-9)) continue;
       if (!flip_if_allowed({f1, f2, a, b, c, d}, allowed, F, valence)) continue;
       touched[f1] = touched[f2] = true;
       created.insert({std::min(c, d), std::max(c, d)});
@@ -260,7 +280,8 @@ void sample_closed(const TriMesh& mesh, int n0, const Eigen::VectorXd* density, 
 
 }  // namespace
 
-BaseMesh build_base_mesh(const Parameterization& param, int n0, int rim_min_triangles, const Eigen::VectorXd* density) {
+BaseMesh build_base_mesh(const Parameterization& param, int n0, int rim_min_triangles, const Eigen::VectorXd* density,
+                         double one_chart_flip_margin_deg) {
   const TriMesh& mesh = param.surface;
   const int n = mesh.num_vertices();
   n0 = std::min(n0, n);
@@ -280,7 +301,7 @@ BaseMesh build_base_mesh(const Parameterization& param, int n0, int rim_min_tria
   // sample left with fewer than rim_min_triangles triangles is dropped and the rest
   // triangulated again: with 2, its corners stay obtuse (~120 degrees in 3D) at every level.
   for (int attempt = 0;; ++attempt) {
-    triangulate_samples(param, input_boundary, rim_min_triangles, base);
+    triangulate_samples(param, input_boundary, rim_min_triangles, one_chart_flip_margin_deg, base);
     if (param.kind != DomainKind::disk || attempt == 4) break;
     const int m = static_cast<int>(base.samples.size());
     std::vector<int> triangles(m, 0);

@@ -66,6 +66,7 @@ void check_sizing_and_finish(const RemeshOptions& o, const std::string& at) {
   require_at_least(at + "base.max_bend", o.base.max_bend, 0.0);
   require_at_least(at + "base.density_smoothing", o.base.density_smoothing, -1);
   require_in(at + "base.rim_min_triangles", o.base.rim_min_triangles, 1, 3);
+  require_in(at + "base.one_chart_flip_margin_deg", o.base.one_chart_flip_margin_deg, 0.0, 180.0);
   require_at_least(at + "snap.max_snaps", o.snap.max_snaps, 0);
   require_at_least(at + "snap.min_distance", o.snap.min_distance, 0.0);
   require_at_least(at + "snap.min_gain", o.snap.min_gain, 0.0);
@@ -124,7 +125,8 @@ nlohmann::json parameterization_summary(const MappedInput& mapped, const Prepare
 // the result's connectivity and the base's keys of its parameterization summary.
 BaseMesh build_base(const Parameterization& param, const BaseMeshOptions& options, const SizingFields& sizing,
                     Resolution& resolution, RemeshResult& result) {
-  BaseMesh base = build_base_mesh(param, resolution.base_vertices, options.rim_min_triangles, &sizing.base_density);
+  BaseMesh base = build_base_mesh(param, resolution.base_vertices, options.rim_min_triangles, &sizing.base_density,
+                                  options.one_chart_flip_margin_deg);
   const int n0 = static_cast<int>(base.domain.rows());
   resolution.base_vertices = n0;
   result.connectivity = subdivide_connectivity(base.faces, n0, resolution.levels);

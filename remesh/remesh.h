@@ -17,6 +17,7 @@
 #include "mesh/progress.h"
 #include "mesh/subdivision.h"
 #include "mesh/trimesh.h"
+#include "remesh/base_mesh.h"
 #include "remesh/feature_snap.h"
 #include "remesh/parameterization.h"
 #include "remesh/surface_fit.h"
@@ -76,6 +77,10 @@ struct BaseMeshOptions {
   /// Disk inputs: a base rim vertex with fewer triangles than this is dropped (with 2 its
   /// corners stay obtuse at every level). 1 = keep all.
   int rim_min_triangles = 3;
+  /// One-chart sphere maps: a base edge whose two facing angles on the surface sum to more
+  /// than 180° plus this many degrees is flipped, where the sphere allows it (remesh/base_mesh.h:
+  /// the sphere's Delaunay triangulation is long in 3D where the map stretches). 180 = off.
+  double one_chart_flip_margin_deg = kOneChartFlipMarginDeg;
 };
 
 /// The relaxation of each level: Lloyd steps in D (remesh/lloyd.h), shape smoothing and the

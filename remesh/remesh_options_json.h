@@ -26,7 +26,7 @@ void from_json(const nlohmann::json& j, SphereMap& map);
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SimplifyOptions, above_faces)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SizingOptions, curvature_weight, curvature_exponent, density_exponent)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(BaseMeshOptions, density_exponent, density_smoothing, max_bend,
-                                                rim_min_triangles)
+                                                rim_min_triangles, one_chart_flip_margin_deg)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RelaxationOptions, lloyd_iterations, shape_iterations,
                                                 surface_iterations, surface_quality_floor, smooth_rim)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FeatureSnapOptions, max_snaps, min_distance, min_quality, min_angle_deg,

@@ -1,6 +1,6 @@
-// Tests of the base mesh's density-scaled farthest-point sampling, the 1-ring smoothing of a
-// vertex field, and the triangle repair that projects its moves onto another surface (the
-// original input of a simplified one).
+// Tests of the base mesh's density-scaled farthest-point sampling and its flips on a one-chart
+// map, the 1-ring smoothing of a vertex field, and the triangle repair that projects its moves
+// onto another surface (the original input of a simplified one).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -259,8 +259,11 @@ TEST(FeatureSnap, ATipTheNearestCornerCannotTakeGoesToTheNextCorner) {
   ASSERT_EQ(snaps, 1);
   EXPECT_TRUE(snapped[g.next]);
   EXPECT_TRUE(g.X.row(g.next) == tip);
-  for (int v = 0; v < g.X.rows(); ++v)
-    if (v != g.next) EXPECT_TRUE(g.X.row(v) == X0.row(v)) << v;
+  for (int v = 0; v < g.X.rows(); ++v) {
+    if (v != g.next) {
+      EXPECT_TRUE(g.X.row(v) == X0.row(v)) << v;
+    }
+  }
 }
 
 // A tip too high for any corner to take it the whole way is taken part of the way, as far as
@@ -387,6 +390,35 @@ TEST(FeatureSnap, RemeshWithZeroSnapTipsSnapsNothing) {
   o.snap.max_snaps = 0;
   const RemeshResult r = remesh(ellipsoid(3), o);
   for (const RemeshLevel& level : r.levels) EXPECT_EQ(level.stats["snapped_vertices"].get<int>(), 0);
+}
+
+double mean_base_quality(const BaseMesh& base, const TriMesh& surface) {
+  double sum = 0;
+  for (int f = 0; f < base.faces.rows(); ++f) {
+    Eigen::Vector3d corner[3];
+    for (int k = 0; k < 3; ++k) corner[k] = surface.V.row(base.samples[base.faces(f, k)]).transpose();
+    sum += frey_borouchaki_quality(corner[0], corner[1], corner[2]);
+  }
+  return sum / static_cast<double>(base.faces.rows());
+}
+
+// A capsule 5 radii long under the one-chart map: the sphere's Delaunay triangulation of the
+// samples has edges well past Delaunay on the surface, where the map squeezes the tube. The
+// margin's flips raise the base triangles' mean quality on the surface (measured: 0.733 ->
+// 0.764 with 40 base vertices, 0.753 -> 0.771 with 127); with a margin of 180° none is made.
+TEST(BaseMeshDensity, OneChartBaseEdgesFarPastDelaunayOnTheSurfaceAreFlipped) {
+  const TriMesh input = test::capsule(5.0, 24);
+  const Parameterization param = parameterize(input);
+  ASSERT_NE(param.sphere_map, SphereMap::hierarchical);
+  for (int n0 : {40, 127}) {
+    SCOPED_TRACE(n0);
+    const BaseMesh flipped = build_base_mesh(param, n0, 3, nullptr, kOneChartFlipMarginDeg);
+    const BaseMesh sphere_delaunay = build_base_mesh(param, n0, 3, nullptr, 180.0);
+    EXPECT_GT(flipped.surface_flips, 0);
+    EXPECT_EQ(sphere_delaunay.surface_flips, 0);
+    EXPECT_EQ(count_flipped(flipped.domain, flipped.faces), 0);
+    EXPECT_GT(mean_base_quality(flipped, param.surface), mean_base_quality(sphere_delaunay, param.surface) + 0.01);
+  }
 }
 
 }  // namespace

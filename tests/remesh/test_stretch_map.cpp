@@ -159,3 +159,32 @@ TEST(BaseMeshFlips, AnEdgeFacingTwoObtuseSurfaceAnglesIsFlippedWhereDAllows) {
   // With ±y antipodal in D, the new faces would lie on a great circle: D forbids the flip.
   EXPECT_EQ(flip_toward_surface_delaunay(octahedron, X, G), 0);
 }
+
+TEST(BaseMeshFlips, AMarginLeavesEdgesOnlyJustPastDelaunay) {
+  // The octahedron of the test above, with ±y at distance t from the midpoint of the edge
+  // +x/+z (half length h = √2/2), square to it: the two angles facing that edge sum to
+  // 4·atan(h / t). At 190° the edge flips with a margin of 5° and stays with one of 15°; at
+  // 200° it flips with 15° too.
+  const double pi = 3.14159265358979323846, h = std::sqrt(0.5), degree = pi / 180;
+  RowMatrixX3d D(6, 3);
+  D << 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1;
+  D.row(2) = Eigen::RowVector3d(0.5, 1, 0.5).normalized();
+  D.row(3) = Eigen::RowVector3d(0.5, -1, 0.5).normalized();
+  const auto joins_y_poles = [&](double facing_sum_deg, double margin_deg) {
+    RowMatrixX3i F(8, 3);
+    F << 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5;
+    const double t = h / std::tan(facing_sum_deg * degree / 4);
+    RowMatrixX3d X = D;
+    X.row(2) << 0.5, t, 0.5;
+    X.row(3) << 0.5, -t, 0.5;
+    flip_toward_surface_delaunay(D, X, F, {margin_deg * degree});
+    EXPECT_EQ(count_flipped(D, F), 0);
+    bool joined = false;
+    for (int f = 0; f < F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) joined = joined || (F(f, k) == 2 && F(f, (k + 1) % 3) == 3);
+    return joined;
+  };
+  EXPECT_TRUE(joins_y_poles(190, 5));
+  EXPECT_FALSE(joins_y_poles(190, 15));
+  EXPECT_TRUE(joins_y_poles(200, 15));
+}
