@@ -392,14 +392,14 @@ TEST(FeatureSnap, RemeshWithZeroSnapTipsSnapsNothing) {
   for (const RemeshLevel& level : r.levels) EXPECT_EQ(level.stats["snapped_vertices"].get<int>(), 0);
 }
 
+// The base's mean Q on the surface: its faces over the samples' 3D points.
 double mean_base_quality(const BaseMesh& base, const TriMesh& surface) {
-  double sum = 0;
-  for (int f = 0; f < base.faces.rows(); ++f) {
-    Eigen::Vector3d corner[3];
-    for (int k = 0; k < 3; ++k) corner[k] = surface.V.row(base.samples[base.faces(f, k)]).transpose();
-    sum += frey_borouchaki_quality(corner[0], corner[1], corner[2]);
-  }
-  return sum / static_cast<double>(base.faces.rows());
+  TriMesh on_surface;
+  on_surface.V.resize(static_cast<Eigen::Index>(base.samples.size()), 3);
+  for (std::size_t i = 0; i < base.samples.size(); ++i)
+    on_surface.V.row(static_cast<Eigen::Index>(i)) = surface.V.row(base.samples[i]);
+  on_surface.F = base.faces;
+  return mesh_quality(on_surface).q_mean;
 }
 
 // A capsule 5 radii long under the one-chart map: the sphere's Delaunay triangulation of the

@@ -33,6 +33,36 @@ double area_stretch_spread_log10(const TriMesh& mesh, const RowMatrixX3d& D) {
   return std::log10(hi / lo);
 }
 
+// The unit octahedron: +x, -x, +y, -y, +z, -z.
+RowMatrixX3d octahedron_vertices() {
+  RowMatrixX3d V(6, 3);
+  V << 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1;
+  return V;
+}
+
+RowMatrixX3i octahedron_faces() {
+  RowMatrixX3i F(8, 3);
+  F << 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5;
+  return F;
+}
+
+// The octahedron with ±y tilted toward +x+z, so that the quad around the edge +z/+x is
+// strictly convex in D.
+RowMatrixX3d tilted_octahedron() {
+  RowMatrixX3d D = octahedron_vertices();
+  D.row(2) = Eigen::RowVector3d(0.5, 1, 0.5).normalized();
+  D.row(3) = Eigen::RowVector3d(0.5, -1, 0.5).normalized();
+  return D;
+}
+
+// Whether some face of F has the directed edge a -> b.
+bool has_edge(const RowMatrixX3i& F, int a, int b) {
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      if (F(f, k) == a && F(f, (k + 1) % 3) == b) return true;
+  return false;
+}
+
 }  // namespace
 
 TEST(HierarchicalMap, ACapsuleTooLongForOneChartEmbedsWithItsSqueezeBounded) {
@@ -135,26 +165,18 @@ TEST(BaseMeshFlips, AnEdgeFacingTwoObtuseSurfaceAnglesIsFlippedWhereDAllows) {
   // An octahedron in D with ±y tilted toward +x+z, so that the quad around the edge +z/+x is
   // strictly convex. On the surface, ±y sit next to that edge's midpoint: the two angles facing
   // it are about 164° each, and the surface's Delaunay triangulation has the edge +y/-y instead.
-  RowMatrixX3d octahedron(6, 3);
-  octahedron << 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1;
-  RowMatrixX3d D = octahedron;
-  D.row(2) = Eigen::RowVector3d(0.5, 1, 0.5).normalized();
-  D.row(3) = Eigen::RowVector3d(0.5, -1, 0.5).normalized();
-  RowMatrixX3i F(8, 3);
-  F << 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5;
+  const RowMatrixX3d octahedron = octahedron_vertices();
+  const RowMatrixX3d D = tilted_octahedron();
+  RowMatrixX3i F = octahedron_faces();
   ASSERT_EQ(count_flipped(D, F), 0);
   RowMatrixX3d X = D;
   X.row(2) << 0.5, 0.1, 0.5;
   X.row(3) << 0.5, -0.1, 0.5;
   EXPECT_GE(flip_toward_surface_delaunay(D, X, F), 1);
   EXPECT_EQ(count_flipped(D, F), 0);
-  bool joined = false;
-  for (int f = 0; f < F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) joined = joined || (F(f, k) == 2 && F(f, (k + 1) % 3) == 3);
-  EXPECT_TRUE(joined);
+  EXPECT_TRUE(has_edge(F, 2, 3));
   // On the octahedron itself every angle is 60°: nothing to flip.
-  RowMatrixX3i G(8, 3);
-  G << 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5;
+  RowMatrixX3i G = octahedron_faces();
   EXPECT_EQ(flip_toward_surface_delaunay(octahedron, octahedron, G), 0);
   // With ±y antipodal in D, the new faces would lie on a great circle: D forbids the flip.
   EXPECT_EQ(flip_toward_surface_delaunay(octahedron, X, G), 0);
@@ -166,23 +188,16 @@ TEST(BaseMeshFlips, AMarginLeavesEdgesOnlyJustPastDelaunay) {
   // 4·atan(h / t). At 190° the edge flips with a margin of 5° and stays with one of 15°; at
   // 200° it flips with 15° too.
   const double pi = 3.14159265358979323846, h = std::sqrt(0.5), degree = pi / 180;
-  RowMatrixX3d D(6, 3);
-  D << 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1;
-  D.row(2) = Eigen::RowVector3d(0.5, 1, 0.5).normalized();
-  D.row(3) = Eigen::RowVector3d(0.5, -1, 0.5).normalized();
+  const RowMatrixX3d D = tilted_octahedron();
   const auto joins_y_poles = [&](double facing_sum_deg, double margin_deg) {
-    RowMatrixX3i F(8, 3);
-    F << 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5;
+    RowMatrixX3i F = octahedron_faces();
     const double t = h / std::tan(facing_sum_deg * degree / 4);
     RowMatrixX3d X = D;
     X.row(2) << 0.5, t, 0.5;
     X.row(3) << 0.5, -t, 0.5;
     flip_toward_surface_delaunay(D, X, F, {margin_deg * degree});
     EXPECT_EQ(count_flipped(D, F), 0);
-    bool joined = false;
-    for (int f = 0; f < F.rows(); ++f)
-      for (int k = 0; k < 3; ++k) joined = joined || (F(f, k) == 2 && F(f, (k + 1) % 3) == 3);
-    return joined;
+    return has_edge(F, 2, 3);
   };
   EXPECT_TRUE(joins_y_poles(190, 5));
   EXPECT_FALSE(joins_y_poles(190, 15));
