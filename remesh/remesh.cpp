@@ -611,7 +611,8 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["shape_iterations"] = options.relax == RelaxMode::all_vertices ? options.relaxation.shape_iterations : 0;
   j["repair_sweeps"] = options.relax == RelaxMode::all_vertices ? options.repair.sweeps : 0;
   j["repair_threshold"] = options.repair.threshold;
-  j["repair_coarse_levels"] = options.repair.coarse_levels;
+  // The base-mesh domain repairs its finest level only (remesh/base_route.cpp).
+  j["repair_coarse_levels"] = result.domain != "base_mesh" && options.repair.coarse_levels;
   j["repair_guard_finest"] = options.repair.guard_finest;
   j["repair_error_tolerance"] = options.repair.error_tolerance;
   j["rim_min_triangles"] = options.base.rim_min_triangles;

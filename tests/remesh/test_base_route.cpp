@@ -72,6 +72,9 @@ TEST(BaseDomainRemesh, ALongCapsuleNestsUnflippedAndWellShaped) {
   const nlohmann::json report = remesh_report(r, base_domain_options(4000));
   EXPECT_EQ(report["lloyd_iterations"], 0);
   EXPECT_EQ(report["options"]["relaxation"]["lloyd_iterations"], 8);  // the run, to repeat it
+  // Nor a repair of its coarse levels, whatever the option asks.
+  EXPECT_EQ(report["repair_coarse_levels"], false);
+  EXPECT_EQ(report["options"]["repair"]["coarse_levels"], true);
 }
 
 TEST(BaseDomainRemesh, ACoarseInputIsSplitFlatSoTheFinestLevelsTrianglesHoldTheirShape) {
