@@ -19,8 +19,11 @@ trap 'rm -rf "$out"' EXIT
 "$bin" -q mc --labels "$labels" --label 255 -o "$out/voxels.vtp" > /dev/null
 "$bin" -q mc --labels "$labels" --label 255 --smooth 20 -o "$out/smoothed.vtp" > /dev/null
 levels="$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['levels'])" "$out/summary.json")"
-"$bin" -q quality "$out/liver.model/level_$levels.vtp" --reference "$out/voxels.vtp" --json > "$out/quality.json"
-"$bin" -q quality "$out/liver.model/level_$levels.vtp" --reference "$out/smoothed.vtp" --json > "$out/quality20.json"
+# The structure's folder in the model, as model.json names it.
+structure="$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['structures'][0]['path'])" "$out/liver.model/model.json")"
+finest="$out/liver.model/$structure/level_$levels.vtp"
+"$bin" -q quality "$finest" --reference "$out/voxels.vtp" --json > "$out/quality.json"
+"$bin" -q quality "$finest" --reference "$out/smoothed.vtp" --json > "$out/quality20.json"
 python3 - "$out/summary.json" "$out/time" "$out/quality.json" "$out/quality20.json" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))
