@@ -552,6 +552,25 @@ void measure_levels(const TriMesh& input, RemeshResult& result) {
     measure_level(original, *result.input_locator, result.connectivity.faces[j], result.levels[j]);
 }
 
+// `options` with the steps that did not run for `result` set to off, for the report's summary:
+// --strict and --no-relax have no shape smoothing, surface relaxation, snap, fit or repair, and
+// the base-mesh domain has no Lloyd step in D (it relaxes by shape smoothing and area
+// centroids) and repairs its finest level only (remesh/base_route.cpp).
+RemeshOptions options_as_run(const RemeshResult& result, RemeshOptions options) {
+  if (options.relax != RelaxMode::all_vertices) {
+    options.relaxation.shape_iterations = 0;
+    options.relaxation.surface_iterations = 0;
+    options.snap.max_snaps = 0;
+    options.fit.rounds = 0;
+    options.repair.sweeps = 0;
+  }
+  if (result.domain == "base_mesh") {
+    options.relaxation.lloyd_iterations = 0;
+    options.repair.coarse_levels = false;
+  }
+  return options;
+}
+
 }  // namespace
 
 RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
@@ -592,30 +611,29 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["levels"] = result.connectivity.levels();
   // The options as `mrsnake remesh --config` reads them: the run can be repeated exactly.
   j["options"] = options;
-  // The method's main settings at the top level too (the report page shows some of them).
-  j["relax"] = options.relax;
-  j["density_exponent"] = options.sizing.density_exponent;
-  j["curvature_weight"] = options.sizing.curvature_weight;
-  j["curvature_exponent"] = options.sizing.curvature_exponent;
-  j["surface_relax_iterations"] = options.relax == RelaxMode::all_vertices ? options.relaxation.surface_iterations : 0;
-  j["surface_relax_quality_floor"] = options.relaxation.surface_quality_floor;
-  j["smooth_rim"] = options.relaxation.smooth_rim;
-  j["base_density_exponent"] = options.base.density_exponent;
-  j["repair_after_reprojection"] = options.repair.after_reprojection;
-  j["snap_tips"] = options.relax == RelaxMode::all_vertices ? options.snap.max_snaps : 0;
-  j["fit_rounds"] = options.relax == RelaxMode::all_vertices ? options.fit.rounds : 0;
-  j["base_density_smoothing"] = options.base.density_smoothing;
-  j["max_base_bend"] = options.base.max_bend;
-  // The base-mesh domain has no Lloyd step in D (it relaxes by shape smoothing and area centroids).
-  j["lloyd_iterations"] = result.domain == "base_mesh" ? 0 : options.relaxation.lloyd_iterations;
-  j["shape_iterations"] = options.relax == RelaxMode::all_vertices ? options.relaxation.shape_iterations : 0;
-  j["repair_sweeps"] = options.relax == RelaxMode::all_vertices ? options.repair.sweeps : 0;
-  j["repair_threshold"] = options.repair.threshold;
-  // The base-mesh domain repairs its finest level only (remesh/base_route.cpp).
-  j["repair_coarse_levels"] = result.domain != "base_mesh" && options.repair.coarse_levels;
-  j["repair_guard_finest"] = options.repair.guard_finest;
-  j["repair_error_tolerance"] = options.repair.error_tolerance;
-  j["rim_min_triangles"] = options.base.rim_min_triangles;
+  // The method's main settings at the top level too, as they ran (the report page shows some).
+  const RemeshOptions ran = options_as_run(result, options);
+  j["relax"] = ran.relax;
+  j["density_exponent"] = ran.sizing.density_exponent;
+  j["curvature_weight"] = ran.sizing.curvature_weight;
+  j["curvature_exponent"] = ran.sizing.curvature_exponent;
+  j["surface_relax_iterations"] = ran.relaxation.surface_iterations;
+  j["surface_relax_quality_floor"] = ran.relaxation.surface_quality_floor;
+  j["smooth_rim"] = ran.relaxation.smooth_rim;
+  j["base_density_exponent"] = ran.base.density_exponent;
+  j["repair_after_reprojection"] = ran.repair.after_reprojection;
+  j["snap_tips"] = ran.snap.max_snaps;
+  j["fit_rounds"] = ran.fit.rounds;
+  j["base_density_smoothing"] = ran.base.density_smoothing;
+  j["max_base_bend"] = ran.base.max_bend;
+  j["lloyd_iterations"] = ran.relaxation.lloyd_iterations;
+  j["shape_iterations"] = ran.relaxation.shape_iterations;
+  j["repair_sweeps"] = ran.repair.sweeps;
+  j["repair_threshold"] = ran.repair.threshold;
+  j["repair_coarse_levels"] = ran.repair.coarse_levels;
+  j["repair_guard_finest"] = ran.repair.guard_finest;
+  j["repair_error_tolerance"] = ran.repair.error_tolerance;
+  j["rim_min_triangles"] = ran.base.rim_min_triangles;
   j["parameterization"] = result.parameterization;
   double total = own_seconds(result);
   // Where both domains were built, the one not kept took its time too.
