@@ -117,12 +117,14 @@ int relax_level(const BaseContext& ctx, const RelaxationOptions& options, int j,
   const RowMatrixX3i& F = ctx.connectivity.faces[j];
   BaseSmoothingOptions shapes;
   shapes.iterations = options.shape_iterations;
+  shapes.slide_rim = options.smooth_rim;
   int moves = smooth_on_base(F, ctx.domain, ctx.lift, layout, shapes);
   BaseSmoothingOptions sizes;
   sizes.iterations = options.surface_iterations;
   sizes.target = SmoothingTarget::area_centroid;
   sizes.quality_floor = options.surface_quality_floor;
   sizes.surface_density = &ctx.wanted;
+  sizes.slide_rim = options.smooth_rim;
   moves += smooth_on_base(F, ctx.domain, ctx.lift, layout, sizes);
   return moves;
 }

@@ -553,13 +553,15 @@ void measure_levels(const TriMesh& input, RemeshResult& result) {
 }
 
 // `options` with the steps that did not run for `result` set to off, for the report's summary:
-// --strict and --no-relax have no shape smoothing, surface relaxation, snap, fit or repair, and
-// the base-mesh domain has no Lloyd step in D (it relaxes by shape smoothing and area
-// centroids) and repairs its finest level only (remesh/base_route.cpp).
+// --strict and --no-relax have no shape smoothing, surface relaxation (so no rim sliding), snap,
+// fit or repair, and the base-mesh domain has no Lloyd step in D (it relaxes by shape smoothing
+// and area centroids) and repairs its finest level only, before any projection onto the
+// original (remesh/base_route.cpp).
 RemeshOptions options_as_run(const RemeshResult& result, RemeshOptions options) {
   if (options.relax != RelaxMode::all_vertices) {
     options.relaxation.shape_iterations = 0;
     options.relaxation.surface_iterations = 0;
+    options.relaxation.smooth_rim = false;
     options.snap.max_snaps = 0;
     options.fit.rounds = 0;
     options.repair.sweeps = 0;
@@ -567,6 +569,7 @@ RemeshOptions options_as_run(const RemeshResult& result, RemeshOptions options) 
   if (result.domain == "base_mesh") {
     options.relaxation.lloyd_iterations = 0;
     options.repair.coarse_levels = false;
+    options.repair.after_reprojection = false;
   }
   return options;
 }

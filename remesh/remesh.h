@@ -120,7 +120,8 @@ struct RepairOptions {
   double error_tolerance = 0.03;
   /// With a simplified input: project each level onto the original input before the repair
   /// (which then moves vertices on the original) instead of after it, so that the repair sees
-  /// the triangles the projection shears.
+  /// the triangles the projection shears. The base-mesh domain repairs on the surface it
+  /// parameterized, then projects (its repair moves vertices in its charts), either way.
   bool after_reprojection = true;
 };
 

@@ -75,6 +75,8 @@ TEST(BaseDomainRemesh, ALongCapsuleNestsUnflippedAndWellShaped) {
   // Nor a repair of its coarse levels, whatever the option asks.
   EXPECT_EQ(report["repair_coarse_levels"], false);
   EXPECT_EQ(report["options"]["repair"]["coarse_levels"], true);
+  // It repairs on the surface it parameterized, before any projection onto the original.
+  EXPECT_EQ(report["repair_after_reprojection"], false);
 }
 
 TEST(BaseDomainRemesh, ACoarseInputIsSplitFlatSoTheFinestLevelsTrianglesHoldTheirShape) {
@@ -365,6 +367,28 @@ TEST(BaseDomainRemesh, ADiskRimSlidesAlongTheInputRimToEvenLengths) {
     lengths.push_back((fine.V.row(a) - fine.V.row(b)).norm());
   const auto [shortest, longest] = std::minmax_element(lengths.begin(), lengths.end());
   EXPECT_LT(*longest / *shortest, 2.2) << lengths.size() << " rim edges";
+}
+
+// The rim's edge length ratio at the finest level (longest / shortest).
+double rim_length_ratio(const TriMesh& mesh) {
+  std::vector<double> lengths;
+  for (const auto& [a, b] : boundary_edges(mesh.F, VertexStars(mesh.F, mesh.num_vertices())))
+    lengths.push_back((mesh.V.row(a) - mesh.V.row(b)).norm());
+  const auto [shortest, longest] = std::minmax_element(lengths.begin(), lengths.end());
+  return *longest / *shortest;
+}
+
+TEST(BaseDomainRemesh, WithSmoothRimOffTheRimVerticesStayWhereTheSplitPutThem) {
+  const TriMesh input = wavy_disk(24, 160);
+  RemeshOptions o = base_domain_options(4000);
+  o.relaxation.smooth_rim = false;
+  const RemeshResult r = remesh(input, o);
+  const TriMesh coarse = r.mesh(0), fine = r.mesh(r.connectivity.levels());
+  // K's rim vertices are the first rows of every level: with the rim held they never move.
+  for (const auto& [a, b] : boundary_edges(coarse.F, VertexStars(coarse.F, coarse.num_vertices())))
+    EXPECT_LT((fine.V.row(a) - coarse.V.row(a)).norm(), 1e-12) << "rim vertex " << a;
+  EXPECT_GT(rim_length_ratio(fine), 3.0);  // the uneven spacing the sliding evens (see above)
+  EXPECT_EQ(remesh_report(r, o)["smooth_rim"], false);
 }
 
 // The automatic domain (the default): a capsule long enough that the one-chart sphere map
