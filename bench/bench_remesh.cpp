@@ -20,7 +20,7 @@
 // Inputs (default: all of them, in this order):
 // - meshes DIR/meshes/NAME.off: mushroom, heart, bear, blobby, retinal, armadillo, horse,
 //   octopus, human, cheburashka, cactus, helix (closed genus 0), mask, lilium (disks);
-// - label-derived (kLabelInputs below): liver (liver-labels.nii.gz, label 255), ventricles
+// - label-derived (label_inputs() below): liver (liver-labels.nii.gz, label 255), ventricles
 //   (MRIcrop-seg.gipl.gz, label 1, the lateral ventricles), mouse-hippocampus, mouse-caudate,
 //   mouse-cerebellum (mouse-brain/mouse1_labels.nii.gz, labels 1, 3, 8). The remeshers' input
 //   is the surface `mrsnake build-model` uses by default, made with `mrsnake mc`:
@@ -36,6 +36,10 @@
 //   label's `mrsnake mc --smooth 20` surface (the voxels' surface, windowed-sinc smoothed; the
 //   same --component and --close-tunnels), not against the remeshers' input. When S = 0 the
 //   two are the same surface.
+// - held-out (not a default): the eight genus-0 structures of mice 2, 3 and 4 (labels 1, 3, 5,
+//   7, 8, 9, 13, 18 of mouseN_labels.nii.gz, as mouseN-hippocampus ... mouseN-midbrain-rest),
+//   made and measured as the mice above. No default of the remesher was chosen on them: they
+//   check the targets on shapes it was not tuned on (docs/bench-remesh-held-out.md).
 // - any other name with a '/' or '.' is read as a mesh file.
 //
 // Targets, checked on every mrsnake row (CGAL's rows are the reference of RMS and time):
@@ -151,7 +155,8 @@ int parse_count(std::string s) {
                "  --data DIR        shared data folder (default $MRSNAKE_DATA, else ../shared/data)\n"
                "  --mrsnake PATH    the mrsnake binary (default: the one built beside this benchmark)\n"
                "  --inputs LIST     names under DIR/meshes (.off); liver, ventricles, mouse-hippocampus,\n"
-               "                    mouse-caudate, mouse-cerebellum (labels, through mrsnake mc); or mesh paths\n"
+               "                    mouse-caudate, mouse-cerebellum (labels, through mrsnake mc); held-out\n"
+               "                    (mice 2-4's eight genus-0 structures, mouse2-hippocampus ...); or mesh paths\n"
                "                    (default: the 14 meshes and the 5 labels)\n"
                "  --targets LIST    face counts to aim at (16k accepted)\n"
                "  --out DIR         working folder; bench_remesh.json is written there\n"
@@ -416,25 +421,64 @@ CgalRun cgal_remesh(const TriMesh& input, int target_faces, int iterations, int 
 
 /// An input made from one label of a label volume (see the opening comment).
 struct LabelInput {
-  const char* name;
-  const char* volume;  ///< under --data
+  std::string name;
+  std::string volume;  ///< under --data
   int label;
-  int component;  ///< mc's and build-model's --component: the K-th largest part; 0 = the whole label
+  int component;          ///< mc's and build-model's --component: the K-th largest part; 0 = the whole label
+  bool held_out = false;  ///< not a default input: no default was chosen on it
 };
 
-const LabelInput kLabelInputs[] = {
-    {"liver", "volumes/liver-labels.nii.gz", 255, 0},
-    {"ventricles", "volumes/MRIcrop-seg.gipl.gz", 1, 1},
-    {"mouse-hippocampus", "volumes/mouse-brain/mouse1_labels.nii.gz", 1, 1},
-    {"mouse-caudate", "volumes/mouse-brain/mouse1_labels.nii.gz", 3, 1},
-    {"mouse-cerebellum", "volumes/mouse-brain/mouse1_labels.nii.gz", 8, 1},
-};
+/// The genus-0 mouse structures of the data README (label, name), each hemisphere's first.
+const std::pair<int, const char*> kMouseStructures[] = {
+    {1, "hippocampus"},        {3, "caudate"},       {5, "globus-pallidus"}, {7, "thalamus"}, {8, "cerebellum"},
+    {9, "superior-colliculi"}, {13, "central-gray"}, {18, "midbrain-rest"}};
+
+/// The benchmark's label inputs, then the held-out ones: mice 2 to 4's eight structures
+/// (mouseN-NAME), which no default was chosen on: `--inputs held-out` runs them.
+const std::vector<LabelInput>& label_inputs() {
+  static const std::vector<LabelInput> inputs = [] {
+    std::vector<LabelInput> all = {
+        {"liver", "volumes/liver-labels.nii.gz", 255, 0},
+        {"ventricles", "volumes/MRIcrop-seg.gipl.gz", 1, 1},
+        {"mouse-hippocampus", "volumes/mouse-brain/mouse1_labels.nii.gz", 1, 1},
+        {"mouse-caudate", "volumes/mouse-brain/mouse1_labels.nii.gz", 3, 1},
+        {"mouse-cerebellum", "volumes/mouse-brain/mouse1_labels.nii.gz", 8, 1},
+    };
+    for (int mouse = 2; mouse <= 4; ++mouse)
+      for (const auto& [label, name] : kMouseStructures)
+        all.push_back({"mouse" + std::to_string(mouse) + "-" + name,
+                       "volumes/mouse-brain/mouse" + std::to_string(mouse) + "_labels.nii.gz", label, 1, true});
+    return all;
+  }();
+  return inputs;
+}
+
+/// The names `--inputs held-out` stands for.
+std::vector<std::string> held_out_inputs() {
+  std::vector<std::string> names;
+  for (const LabelInput& in : label_inputs())
+    if (in.held_out) names.push_back(in.name);
+  return names;
+}
+
+/// `names` with `held-out` replaced by the held-out inputs' names.
+std::vector<std::string> with_held_out_expanded(const std::vector<std::string>& names) {
+  std::vector<std::string> expanded;
+  for (const std::string& name : names) {
+    if (name != "held-out") {
+      expanded.push_back(name);
+      continue;
+    }
+    for (const std::string& held_out : held_out_inputs()) expanded.push_back(held_out);
+  }
+  return expanded;
+}
 
 /// build-model's default --close-tunnels (model/build_model.h); a genus-0 label is untouched.
 constexpr int kCloseTunnels = 3;
 
 const LabelInput* find_label_input(const std::string& name) {
-  for (const LabelInput& in : kLabelInputs)
+  for (const LabelInput& in : label_inputs())
     if (name == in.name) return &in;
   return nullptr;
 }
@@ -1004,7 +1048,7 @@ int main(int argc, char** argv) {
         rows.push_back(r);
       }
   };
-  for (const std::string& name : o.inputs) {
+  for (const std::string& name : with_held_out_expanded(o.inputs)) {
     // Resolve the input file, and the surface the distances are measured against.
     std::string path, reference_path;
     std::string label = name;
