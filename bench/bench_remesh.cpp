@@ -453,23 +453,15 @@ const std::vector<LabelInput>& label_inputs() {
   return inputs;
 }
 
-/// The names `--inputs held-out` stands for.
-std::vector<std::string> held_out_inputs() {
-  std::vector<std::string> names;
-  for (const LabelInput& in : label_inputs())
-    if (in.held_out) names.push_back(in.name);
-  return names;
-}
-
 /// `names` with `held-out` replaced by the held-out inputs' names.
 std::vector<std::string> with_held_out_expanded(const std::vector<std::string>& names) {
   std::vector<std::string> expanded;
   for (const std::string& name : names) {
-    if (name != "held-out") {
+    if (name != "held-out")
       expanded.push_back(name);
-      continue;
-    }
-    for (const std::string& held_out : held_out_inputs()) expanded.push_back(held_out);
+    else
+      for (const LabelInput& in : label_inputs())
+        if (in.held_out) expanded.push_back(in.name);
   }
   return expanded;
 }
