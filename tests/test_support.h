@@ -51,7 +51,12 @@ struct CommandResult {
   std::string output;  ///< stdout and stderr together
 };
 
-/// Runs the mrsnake executable (its path is in $MRSNAKE_BIN, set by ctest) with arguments.
+/// The longest one command of a test may run: a command that hangs fails its test with its
+/// own output, instead of stalling the test until ctest's timeout with none.
+constexpr int kCommandTimeoutSeconds = 600;
+
+/// Runs the mrsnake executable (its path is in $MRSNAKE_BIN, set by ctest) with arguments,
+/// stopped after kCommandTimeoutSeconds (exit code 124, and a line saying so).
 inline CommandResult run_mrsnake(const std::string& args) {
   const char* bin = std::getenv("MRSNAKE_BIN");
   CommandResult r;
@@ -59,13 +64,17 @@ inline CommandResult run_mrsnake(const std::string& args) {
     r.output = "MRSNAKE_BIN is not set; run the tests through ctest";
     return r;
   }
-  const std::string cmd = std::string(bin) + " " + args + " 2>&1";
+  const std::string cmd =
+      "timeout -k 10 " + std::to_string(kCommandTimeoutSeconds) + " " + std::string(bin) + " " + args + " 2>&1";
   FILE* pipe = popen(cmd.c_str(), "r");
   if (!pipe) return r;
   std::array<char, 4096> buf{};
   while (fgets(buf.data(), static_cast<int>(buf.size()), pipe)) r.output += buf.data();
   const int status = pclose(pipe);
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if (r.exit_code == 124)
+    r.output += "\n(mrsnake " + args + " did not end within " + std::to_string(kCommandTimeoutSeconds) +
+                " s and was stopped)\n";
   return r;
 }
 

@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+
+#include <cerrno>
+#include <chrono>
 #include <cmath>
 
 #include "apps/report/canvas.h"
@@ -7,6 +11,7 @@
 #include "apps/report/plots.h"
 #include "apps/report/render.h"
 #include "apps/report/slices.h"
+#include "mesh/errors.h"
 #include "mesh/primitives.h"
 #include "tests/test_support.h"
 
@@ -100,4 +105,28 @@ TEST(Report, RenderNeedsADisplayAndMakesAPng) {
     std::fwrite(png.data(), 1, png.size(), f);
     std::fclose(f);
   }
+}
+
+TEST(Report, ARenderOutlastingItsTimeIsStoppedAndLaterOnesAreLeftOut) {
+  // A render that hangs (a stalled display, a lock held at the fork) must cost its picture,
+  // not the program: the child is killed and reaped at the deadline, and the process stops
+  // asking a renderer that did not answer.
+  std::string why;
+  if (!display_available(&why)) GTEST_SKIP() << "no 3D render test: " << why;
+  RenderOptions options;
+  options.max_seconds = 0;  // every render outlasts it
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    render_mesh_png(icosphere(3), options);
+    ADD_FAILURE() << "a render past its deadline returned a picture";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("did not finish within 0 s"), std::string::npos) << e.what();
+  }
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 10.0);
+  // The child was reaped: this process has no child left, not even a zombie.
+  EXPECT_EQ(waitpid(-1, nullptr, WNOHANG), -1);
+  EXPECT_EQ(errno, ECHILD);
+  EXPECT_FALSE(display_available(&why));
+  EXPECT_NE(why.find("did not finish"), std::string::npos) << why;
+  EXPECT_THROW(render_mesh_png(icosphere(1)), Error);
 }
