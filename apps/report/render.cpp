@@ -159,10 +159,6 @@ std::vector<std::uint8_t> render_in_this_process(const TriMesh& mesh, const Rend
   return {result->GetPointer(0), result->GetPointer(0) + result->GetNumberOfValues()};
 }
 
-}  // namespace
-
-namespace {
-
 // A render running in a forked child, its PNG coming through a pipe.
 struct RenderChild {
   pid_t pid = -1;
