@@ -19,6 +19,7 @@ void add_mc_command(CLI::App& app) {
     int close_tunnels = 0;
     int component = 0;
     double spacing = 0;
+    bool remove_spurs = false;
     bool json = false;
   };
   auto a = std::make_shared<Args>();
@@ -39,6 +40,9 @@ void add_mc_command(CLI::App& app) {
                   "Extract the 0.5 isosurface of the label's Gaussian-smoothed occupancy resampled to this isotropic "
                   "spacing in mm (as build-model's surface.mc_spacing_mm); 0 = the voxels' own surface (default)")
       ->check(CLI::Range(0.0, 100.0));
+  cmd->add_flag("--remove-spurs", a->remove_spurs,
+                "First remove the label's spurs, voxels hanging by at most one face, again until none is left (a line "
+                "of voxels one voxel wide, which --smooth turns into a needle); as build-model does");
   cmd->add_flag("--json", a->json, "Print a JSON summary");
   cmd->footer(
       "Example: mrsnake mc --labels liver-labels.nii.gz --label 255 --smooth 20 -o liver.vtp\n"
@@ -53,6 +57,7 @@ void add_mc_command(CLI::App& app) {
     options.smoothing_iterations = a->smooth;
     options.max_closing_radius = a->close_tunnels;
     options.resample_spacing_mm = a->spacing;
+    options.remove_spurs = a->remove_spurs;
     const LabelSurface surface = extract_label_surface(labels, a->label, options, progress);
     if (!surface.dropped_component_faces.empty()) {
       // Components are sorted largest first: the first few sizes say enough.
@@ -81,13 +86,16 @@ void add_mc_command(CLI::App& app) {
                   {"components_found", surface.components_found},
                   {"genus_before_repair", surface.genus_before_repair},
                   {"closing_radius_voxels", surface.closing_radius},
+                  {"spur_voxels_removed", surface.spur_voxels_removed},
                   {"topology", topo},
                   {"enclosed_volume_mm3", enclosed_volume(surface.mesh)},
                   {"label_volume_mm3", static_cast<double>(count) * voxel_volume}});
     } else {
       std::cout << a->output << ": " << surface.mesh.num_vertices() << " vertices, " << surface.mesh.num_faces()
                 << " faces, " << topo.describe() << ", enclosed volume " << enclosed_volume(surface.mesh)
-                << " mm3 (label: " << static_cast<double>(count) * voxel_volume << " mm3)\n";
+                << " mm3 (label: " << static_cast<double>(count) * voxel_volume << " mm3"
+                << (a->remove_spurs ? ", " + std::to_string(surface.spur_voxels_removed) + " spur voxels removed" : "")
+                << ")\n";
     }
   });
 }

@@ -11,6 +11,7 @@
 
 #include "mesh/errors.h"
 #include "mesh/label_repair.h"
+#include "mesh/label_spurs.h"
 #include "mesh/label_resample.h"
 #include "mesh/topology.h"
 #include "mesh/vtk_convert.h"
@@ -136,16 +137,10 @@ LabelSurface extract_once(const Volume& labels, int label, const LabelSurfaceOpt
   return result;
 }
 
-}  // namespace
-
-LabelSurface extract_label_surface(const Volume& labels, int label, const LabelSurfaceOptions& options,
-                                   const ProgressFn& progress) {
-  const auto target = static_cast<float>(label);
-  if (std::none_of(labels.data.begin(), labels.data.end(), [&](float v) { return v == target; }))
-    throw InputError("label " + std::to_string(label) +
-                         " is not present in the volume (labels present: " + labels_present(labels) + ")",
-                     Remedy::choose_label);
-  report(progress, "marching cubes", 0.0);
+// The surface of `label`; if it is not genus 0, that of the label closed with the smallest radius
+// up to options.max_closing_radius that makes it genus 0.
+LabelSurface extract_surface_and_close_tunnels(const Volume& labels, int label, const LabelSurfaceOptions& options,
+                                               const ProgressFn& progress) {
   LabelSurface result = extract_once(labels, label, options, progress);
   result.genus_before_repair = topology_report(result.mesh).genus;
   for (int radius = 1; result.genus_before_repair > 0 && radius <= options.max_closing_radius; ++radius) {
@@ -158,6 +153,28 @@ LabelSurface extract_label_surface(const Volume& labels, int label, const LabelS
       break;
     }
   }
+  return result;
+}
+
+}  // namespace
+
+LabelSurface extract_label_surface(const Volume& labels, int label, const LabelSurfaceOptions& options,
+                                   const ProgressFn& progress) {
+  const auto target = static_cast<float>(label);
+  if (std::none_of(labels.data.begin(), labels.data.end(), [&](float v) { return v == target; }))
+    throw InputError("label " + std::to_string(label) +
+                         " is not present in the volume (labels present: " + labels_present(labels) + ")",
+                     Remedy::choose_label);
+  report(progress, "marching cubes", 0.0);
+  Volume without_spurs;
+  int spur_voxels = 0;
+  if (options.remove_spurs) {
+    without_spurs = labels;
+    spur_voxels = remove_label_spurs(without_spurs, label);
+  }
+  LabelSurface result =
+      extract_surface_and_close_tunnels(spur_voxels > 0 ? without_spurs : labels, label, options, progress);
+  result.spur_voxels_removed = spur_voxels;
   report(progress, "marching cubes", 1.0);
   return result;
 }

@@ -23,6 +23,9 @@ struct LabelSurfaceOptions {
   /// the voxels' own surface: no staircase, and a surface whose size follows the spacing
   /// rather than the image's resolution. 0 = the voxels' surface (discrete flying edges).
   double resample_spacing_mm = 0;
+  /// Remove the label's spurs first (label_spurs.h): voxels hanging by at most one face,
+  /// which smoothing would turn into needles.
+  bool remove_spurs = false;
 };
 
 /// What was extracted, with anything worth a warning.
@@ -32,11 +35,13 @@ struct LabelSurface {
   std::vector<int> dropped_component_faces;  ///< face counts of the dropped components
   int genus_before_repair = 0;               ///< genus of the surface of the label as given
   int closing_radius = 0;                    ///< closing radius (voxels) that made it genus 0; 0 = none
+  int spur_voxels_removed = 0;               ///< voxels removed as spurs (LabelSurfaceOptions::remove_spurs)
 };
 
 /// Extracts the surface of the voxels equal to `label` with discrete flying edges (or of their
 /// resampled occupancy, see LabelSurfaceOptions::resample_spacing_mm), oriented outward,
-/// optionally smoothed, keeping the largest component.
+/// optionally smoothed, keeping the largest component; with options.remove_spurs, of the
+/// label without its spurs.
 /// \throw InputError if no voxel has the label (message lists the labels present), or if
 ///        the surface is empty.
 LabelSurface extract_label_surface(const Volume& labels, int label, const LabelSurfaceOptions& options = {},
