@@ -160,6 +160,7 @@ nlohmann::json summary_json(const BuildModelArgs& a, const BuiltModel& built, do
           {"mc_spacing_mm", built.mc_spacing_mm},
           {"scale", model.scale},
           {"closing_radius_voxels", built.surface.closing_radius},
+          {"spur_voxels_removed", built.surface.spur_voxels_removed},
           {"finest_level_quality", model.remesh_quality["finest_level_quality"]},
           {"finest_level_self_intersections", built.self_intersections},
           {"detail_stats", stats},

@@ -30,11 +30,13 @@
 //       radius / 60 when the voxels are finer than that (the liver: about 1.2 mm), the finest
 //       voxel side for thick slices, else 0 = the voxels' own surface (the ventricles, the mice);
 //     --smooth 5 when S > 0, else 20 (build-model's defaults);
-//     --close-tunnels 3 (build-model's default; nothing changes on a genus-0 label), and
+//     --close-tunnels 3 (build-model's default; nothing changes on a genus-0 label),
+//     --remove-spurs (build-model's default: the label's voxels hanging by at most one face
+//     go, which --smooth would make needles), and
 //     --component 1 (the largest part) for the ventricles and the mice.
 //   Their distances (RMS, Hausdorff), for mrsnake and CGAL alike, are measured against the
 //   label's `mrsnake mc --smooth 20` surface (the voxels' surface, windowed-sinc smoothed; the
-//   same --component and --close-tunnels), not against the remeshers' input. When S = 0 the
+//   same --component, --close-tunnels and --remove-spurs), not against the remeshers' input. When S = 0 the
 //   two are the same surface.
 // - held-out (not a default): the eight genus-0 structures of mice 2, 3 and 4 (labels 1, 3, 5,
 //   7, 8, 9, 13, 18 of mouseN_labels.nii.gz, as mouseN-hippocampus ... mouseN-midbrain-rest),
@@ -535,7 +537,7 @@ LabelSurfaces make_label_input(const Options& o, const LabelInput& in) {
   const int smooth = spacing > 0 ? 5 : 20;  // build-model: 5 on the resampled occupancy, else 20
   std::vector<std::string> label_args = {"--labels", labels, "--label", std::to_string(in.label)};
   if (in.component > 0) label_args.insert(label_args.end(), {"--component", std::to_string(in.component)});
-  label_args.insert(label_args.end(), {"--close-tunnels", std::to_string(kCloseTunnels)});
+  label_args.insert(label_args.end(), {"--close-tunnels", std::to_string(kCloseTunnels), "--remove-spurs"});
 
   LabelSurfaces s;
   s.input_path = (fs::path(o.out) / (std::string(in.name) + ".vtp")).string();
@@ -985,7 +987,8 @@ void write_markdown(const Options& o, const std::vector<Row>& rows, const json& 
         "Hausdorff % = symmetric distance to the reference in % of its bounding-box diagonal ("
      << o.samples
      << " samples per face + vertices); label-derived inputs are measured against their label's "
-        "`mrsnake mc --smooth 20` surface, and where that is not the input, the Inputs table gives the input's own "
+        "`mrsnake mc --smooth 20` surface (its spurs removed, as build-model does), and where that is not the input, "
+        "the Inputs table gives the input's own "
         "distance to it, which a remesh that follows its input does not get below. speed = CGAL's algo s / algo s (> "
         "1: faster than CGAL); cmd speed = "
         "CGAL's call / the whole mrsnake command. Times are medians of "

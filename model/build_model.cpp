@@ -41,6 +41,7 @@ void extract_surface(const Volume& labels, const BuildModelOptions& options, con
   LabelSurfaceOptions mc;
   mc.smoothing_iterations = built.smoothing_iterations;
   mc.max_closing_radius = o.close_tunnels;
+  mc.remove_spurs = o.remove_spurs;
   mc.resample_spacing_mm = built.mc_spacing_mm;
   built.surface = extract_label_surface(labels, options.label, mc, progress);
   const LabelSurface& s = built.surface;

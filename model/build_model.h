@@ -40,6 +40,9 @@ struct ModelSurfaceOptions {
   int smoothing_iterations = -1;
   /// Tunnels are closed with radii up to this many voxels until the surface is genus 0; 0 = none.
   int close_tunnels = 3;
+  /// Remove the label's spurs (mesh/label_spurs.h) first: voxels hanging by at most one face,
+  /// which the smoothing turns into needles that no level of the model can follow.
+  bool remove_spurs = true;
 };
 
 /// What build_model() measures beyond the model, for its report page.

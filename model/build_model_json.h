@@ -24,7 +24,8 @@ void from_json(const nlohmann::json& j, ProfileAlignment& alignment);
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(WaveletOptions, predict, update, frame, degenerate_frame_tolerance)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(AppearanceOptions, half_length, shell_voxels, alignment,
                                                 clean_edge_max_residual, max_alignment_voxels)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ModelSurfaceOptions, mc_spacing_mm, smoothing_iterations, close_tunnels)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ModelSurfaceOptions, mc_spacing_mm, smoothing_iterations, close_tunnels,
+                                                remove_spurs)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ModelReportOptions, level_stats, compare_unrelaxed)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(BuildModelOptions, label, component, surface, faces, levels, remesh,
                                                 wavelet, appearance, reference_margin_mm, allow_poor_fit, report)

@@ -156,7 +156,9 @@ TEST(BuildModelCli, FlagsAModelWhoseFinestLevelPassesThroughItself) {
   MRSNAKE_REQUIRE_DATA(labels, "volumes/mouse-brain/mouse1_labels.nii.gz");
   const auto dir = scratch_dir("build-model-crossing");
   const std::string model = (dir / "ventricles.model").string();
-  const auto built = run_mrsnake("-q build-model --labels " + labels + " --label 10 -o " + model);
+  // With its spurs, the label's smoothed surface has needles that the finest level folds at.
+  const auto built = run_mrsnake("-q build-model --labels " + labels + " --label 10 -o " + model +
+                                 config_arg(dir, "spurs", {{"surface", {{"remove_spurs", false}}}}));
   ASSERT_EQ(built.exit_code, 0) << built.output;
   const ShapeModel m = load_model_set(model, {true}).structures.at(0).model;
   const int crossings = m.remesh_quality["finest_level_self_intersections"].get<int>();
