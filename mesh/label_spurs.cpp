@@ -36,21 +36,20 @@ int remove_label_spurs(Volume& labels, int label) {
     for_each_face_neighbour(labels, v, [&](std::size_t u) { neighbours[v] += labels.data[u] == target; });
     if (neighbours[v] <= 1) queue.push_back(v);
   }
-  // Removing a spur can leave its holder hanging by one face in turn: it joins the queue.
-  std::vector<std::size_t> removed;
+  // Removing a spur can leave its holder hanging by one face in turn: it joins the queue. Every
+  // voxel queued is removed, so the queue ends up listing them all.
   for (std::size_t next = 0; next < queue.size(); ++next) {
     const std::size_t v = queue[next];
     labels.data[v] = 0;
-    removed.push_back(v);
     for_each_face_neighbour(labels, v, [&](std::size_t u) {
       if (labels.data[u] == target && neighbours[u]-- == 2) queue.push_back(u);
     });
   }
-  if (removed.size() == label_voxels) {
-    for (std::size_t v : removed) labels.data[v] = target;
+  if (queue.size() == label_voxels) {
+    for (std::size_t v : queue) labels.data[v] = target;
     return 0;
   }
-  return static_cast<int>(removed.size());
+  return static_cast<int>(queue.size());
 }
 
 }  // namespace mrsnake

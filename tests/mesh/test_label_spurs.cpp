@@ -36,7 +36,7 @@ long count_of(const Volume& v, float label) { return std::count(v.data.begin(), 
 TEST(LabelSpurs, ALineHangingFromABoxGoesBackToTheBoxAndOtherLabelsStay) {
   Volume v = empty_grid(16);
   fill_box(v, {4, 4, 4}, {8, 8, 8}, 3);
-  fill_box(v, {8, 5, 5}, {11, 6, 6}, 3);  // three voxels in a line off the box's +x face
+  fill_box(v, {8, 5, 5}, {11, 6, 6}, 3);   // three voxels in a line off the box's +x face
   fill_box(v, {1, 12, 1}, {6, 13, 2}, 9);  // a line of another label
   EXPECT_EQ(remove_label_spurs(v, 3), 3);
   EXPECT_EQ(count_of(v, 3), 64);
@@ -88,7 +88,8 @@ TEST(McCommand, RemoveSpursReportsTheVoxelsItRemoved) {
   const std::string img = (dir / "labels.nii.gz").string();
   write_volume(img, v, VoxelType::uint8);
   const auto faces_and_spurs = [&](const std::string& flags) {
-    const auto r = test::run_mrsnake("-q mc --labels " + img + " --label 3 -o " + (dir / "s.vtp").string() + " --json" + flags);
+    const auto r =
+        test::run_mrsnake("-q mc --labels " + img + " --label 3 -o " + (dir / "s.vtp").string() + " --json" + flags);
     EXPECT_EQ(r.exit_code, 0) << r.output;
     const nlohmann::json j = nlohmann::json::parse(r.output);
     return std::make_pair(j["faces"].get<int>(), j["spur_voxels_removed"].get<int>());
