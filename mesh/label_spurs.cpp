@@ -1,8 +1,6 @@
 #include "mesh/label_spurs.h"
 
-#include <array>
 #include <cstdint>
-#include <vector>
 
 namespace mrsnake {
 namespace {
@@ -22,34 +20,41 @@ void for_each_face_neighbour(const Volume& volume, std::size_t v, Visit&& visit)
 
 }  // namespace
 
-int remove_label_spurs(Volume& labels, int label) {
+std::vector<std::size_t> label_spurs(const Volume& labels, int label) {
   const auto target = static_cast<float>(label);
-  if (target == 0.0f) return 0;  // the background has no spurs to set to background
+  if (target == 0.0f) return {};  // the background has no spurs to set to background
+  // Per voxel: its face neighbours still in the label, or kGone outside the label and once removed.
+  constexpr std::uint8_t kGone = 255;
   const std::size_t n = labels.num_voxels();
-  // Face neighbours in the label, per voxel of the label; a queue of the voxels with at most one.
-  std::vector<std::uint8_t> neighbours(n, 0);
-  std::vector<std::size_t> queue;
+  std::vector<std::uint8_t> neighbours(n, kGone);
   std::size_t label_voxels = 0;
+  for (std::size_t v = 0; v < n; ++v)
+    if (labels.data[v] == target) {
+      neighbours[v] = 0;
+      ++label_voxels;
+    }
+  std::vector<std::size_t> queue;  // the voxels with at most one neighbour, removed in turn
   for (std::size_t v = 0; v < n; ++v) {
-    if (labels.data[v] != target) continue;
-    ++label_voxels;
-    for_each_face_neighbour(labels, v, [&](std::size_t u) { neighbours[v] += labels.data[u] == target; });
+    if (neighbours[v] == kGone) continue;
+    for_each_face_neighbour(labels, v, [&](std::size_t u) { neighbours[v] += neighbours[u] != kGone; });
     if (neighbours[v] <= 1) queue.push_back(v);
   }
-  // Removing a spur can leave its holder hanging by one face in turn: it joins the queue. Every
-  // voxel queued is removed, so the queue ends up listing them all.
+  // Removing a spur can leave its holder hanging by one face in turn: it joins the queue.
   for (std::size_t next = 0; next < queue.size(); ++next) {
     const std::size_t v = queue[next];
-    labels.data[v] = 0;
+    neighbours[v] = kGone;
     for_each_face_neighbour(labels, v, [&](std::size_t u) {
-      if (labels.data[u] == target && neighbours[u]-- == 2) queue.push_back(u);
+      if (neighbours[u] != kGone && neighbours[u]-- == 2) queue.push_back(u);
     });
   }
-  if (queue.size() == label_voxels) {
-    for (std::size_t v : queue) labels.data[v] = target;
-    return 0;
-  }
-  return static_cast<int>(queue.size());
+  if (queue.size() == label_voxels) return {};
+  return queue;
+}
+
+int remove_label_spurs(Volume& labels, int label) {
+  const std::vector<std::size_t> spurs = label_spurs(labels, label);
+  for (std::size_t v : spurs) labels.data[v] = 0;
+  return static_cast<int>(spurs.size());
 }
 
 }  // namespace mrsnake

@@ -166,15 +166,16 @@ LabelSurface extract_label_surface(const Volume& labels, int label, const LabelS
                          " is not present in the volume (labels present: " + labels_present(labels) + ")",
                      Remedy::choose_label);
   report(progress, "marching cubes", 0.0);
+  // The label is copied only when it has spurs to remove: a CT volume can be hundreds of MB.
+  const std::vector<std::size_t> spurs = options.remove_spurs ? label_spurs(labels, label) : std::vector<std::size_t>{};
   Volume without_spurs;
-  int spur_voxels = 0;
-  if (options.remove_spurs) {
+  if (!spurs.empty()) {
     without_spurs = labels;
-    spur_voxels = remove_label_spurs(without_spurs, label);
+    for (std::size_t v : spurs) without_spurs.data[v] = 0;
   }
   LabelSurface result =
-      extract_surface_and_close_tunnels(spur_voxels > 0 ? without_spurs : labels, label, options, progress);
-  result.spur_voxels_removed = spur_voxels;
+      extract_surface_and_close_tunnels(spurs.empty() ? labels : without_spurs, label, options, progress);
+  result.spur_voxels_removed = static_cast<int>(spurs.size());
   report(progress, "marching cubes", 1.0);
   return result;
 }
