@@ -348,6 +348,40 @@ TEST(Lloyd, CellStaysInsideANonConvexOneRing) {
   EXPECT_LT((lloyd_cell_centroid(G, W, 6) - Eigen::Vector3d(W.row(6))).norm(), 1e-6);
 }
 
+// Under a density linear on D, one step at a fine level's sampling (one density sample per
+// quadrilateral) takes v exactly to the centroid of its cell weighted by each quadrilateral's
+// density at its own centroid.
+TEST(Lloyd, LinearDensityMovesTheVertexToItsWeightedCentroid) {
+  RowMatrixX3d U(7, 3);
+  U << 0.6, -1.0, 1, 1.0, 0.0, 1, 0.5, 0.05, 1, 0.0, 1.0, 1, -1.0, 0.2, 1, -0.6, -1.0, 1, 0.1, -0.1, 1;
+  RowMatrixX3i F(6, 3);  // vertex 6 and its ring 0..5
+  F << 6, 1, 2, 6, 2, 3, 6, 3, 4, 6, 4, 5, 6, 5, 0, 6, 0, 1;
+  ASSERT_EQ(count_flipped(U, F), 0);
+  const auto rho = [](const Eigen::Vector3d& p) { return 2.0 + 0.8 * p.x() - 0.5 * p.y(); };
+  Eigen::VectorXd vertex_density(7);
+  for (int v = 0; v < 7; ++v) vertex_density[v] = rho(U.row(v).transpose());
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+  double mass = 0;
+  for (int f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d p = U.row(6), a = U.row(F(f, 1)), b = U.row(F(f, 2));
+    const Eigen::Vector3d quad_centroid = (11.0 / 18.0) * p + (7.0 / 36.0) * (a + b);
+    const double weight = rho(quad_centroid) * (a - p).cross(b - p).norm() / 6.0;
+    mass += weight;
+    moment += weight * quad_centroid;
+  }
+  RowMatrixX3d W = U;
+  const DomainMesh domain(U, F);
+  const DensityField density{&domain, vertex_density};
+  std::vector<int> hints(7, 0);
+  LloydOptions options;
+  options.iterations = 1;
+  options.first_movable = 6;
+  options.sample_budget = 6;  // one sample per corner quadrilateral, as on a fine level
+  constrained_lloyd(DomainKind::disk, F, density, W, hints, options);
+  EXPECT_LT((Eigen::Vector3d(W.row(6)) - moment / mass).norm(), 1e-12);
+  EXPECT_GT((W.row(6) - U.row(6)).norm(), 0.01);  // it did move
+}
+
 // The final repair: on an ellipsoid's parameterization, a triangulation of D with a few
 // vertices pushed toward a neighbour (sliver triangles in 3D) is repaired in place: the
 // smallest Q goes up a lot, nothing flips in D, and every vertex is still the exact lift of
