@@ -47,6 +47,7 @@ void check_resolution_and_relaxation(const RemeshOptions& o, const std::string& 
   require_at_least(at + "simplify.above_faces", o.simplify.above_faces, 0);
   require_at_least(at + "relaxation.lloyd_iterations", o.relaxation.lloyd_iterations, 0);
   require_at_least(at + "relaxation.shape_iterations", o.relaxation.shape_iterations, 0);
+  require_at_least(at + "relaxation.guarded_shape_iterations", o.relaxation.guarded_shape_iterations, 0);
   require_at_least(at + "relaxation.surface_iterations", o.relaxation.surface_iterations, 0);
   require_in(at + "relaxation.surface_quality_floor", o.relaxation.surface_quality_floor, 0.0, 1.0);
   // The paper's exact method relaxes new vertices in one domain chart; the base mesh's levels
@@ -554,10 +555,12 @@ void measure_levels(const TriMesh& input, RemeshResult& result) {
 
 // `options` with the steps that did not run for `result` set to off, for the report's summary:
 // --strict and --no-relax have no shape smoothing, surface relaxation (so no rim sliding), snap,
-// fit or repair, and the base-mesh domain has no Lloyd step in D (it relaxes by shape smoothing
-// and area centroids) and repairs its finest level only, before any projection onto the
-// original (remesh/base_route.cpp).
+// fit or repair; the sphere and the disk have no guarded shape sweeps; and the base-mesh domain
+// has no Lloyd step in D (it relaxes by shape smoothing and area centroids) and repairs its
+// finest level only, before any projection onto the original (remesh/base_route.cpp).
 RemeshOptions options_as_run(const RemeshResult& result, RemeshOptions options) {
+  if (options.relax != RelaxMode::all_vertices || result.domain != "base_mesh")
+    options.relaxation.guarded_shape_iterations = 0;
   if (options.relax != RelaxMode::all_vertices) {
     options.relaxation.shape_iterations = 0;
     options.relaxation.surface_iterations = 0;
@@ -631,6 +634,7 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["max_base_bend"] = ran.base.max_bend;
   j["lloyd_iterations"] = ran.relaxation.lloyd_iterations;
   j["shape_iterations"] = ran.relaxation.shape_iterations;
+  j["guarded_shape_iterations"] = ran.relaxation.guarded_shape_iterations;
   j["repair_sweeps"] = ran.repair.sweeps;
   j["repair_threshold"] = ran.repair.threshold;
   j["repair_coarse_levels"] = ran.repair.coarse_levels;

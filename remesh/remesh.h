@@ -92,6 +92,11 @@ struct RelaxationOptions {
   /// triangles, interleaved with the Lloyd iterations. The Lloyd step evens out sizes but is
   /// affine invariant, so it cannot repair shear; this can. 0 = the Lloyd step alone.
   int shape_iterations = 6;
+  /// The base-mesh domain, with all_vertices: sweeps per level of the same smoothing after
+  /// those, each move refused if it lowers the smallest Q of the vertex's triangles. That
+  /// domain has no Lloyd step; these polish the shapes the free sweeps made without undoing
+  /// them anywhere. 0 = off.
+  int guarded_shape_iterations = 8;
   /// With all_vertices: iterations per level of relaxation on the surface after those rounds
   /// (SmoothingTarget::area_centroid): sizes even out where the parameterization's stretch
   /// changes too fast for the Lloyd step in D. 0 = off.

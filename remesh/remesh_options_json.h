@@ -28,7 +28,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SizingOptions, curvature_weight,
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(BaseMeshOptions, density_exponent, density_smoothing, max_bend,
                                                 rim_min_triangles, one_chart_flip_margin_deg)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RelaxationOptions, lloyd_iterations, shape_iterations,
-                                                surface_iterations, surface_quality_floor, smooth_rim)
+                                                guarded_shape_iterations, surface_iterations, surface_quality_floor,
+                                                smooth_rim)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(FeatureSnapOptions, max_snaps, min_distance, min_quality, min_angle_deg,
                                                 min_gain, min_share_of_largest)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RepairOptions, sweeps, threshold, coarse_levels, guard_finest,

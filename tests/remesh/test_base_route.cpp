@@ -72,6 +72,7 @@ TEST(BaseDomainRemesh, ALongCapsuleNestsUnflippedAndWellShaped) {
   const nlohmann::json report = remesh_report(r, base_domain_options(4000));
   EXPECT_EQ(report["lloyd_iterations"], 0);
   EXPECT_EQ(report["options"]["relaxation"]["lloyd_iterations"], 8);  // the run, to repeat it
+  EXPECT_EQ(report["guarded_shape_iterations"], 8);  // in the Lloyd step's place
   // Nor a repair of its coarse levels, whatever the option asks.
   EXPECT_EQ(report["repair_coarse_levels"], false);
   EXPECT_EQ(report["options"]["repair"]["coarse_levels"], true);
@@ -209,6 +210,40 @@ TEST(BaseLevels, RepairRaisesTheWorstQualityOnTheInputWithoutAFlip) {
       off = std::max(off, (layout.X.row(v).transpose() - lift.lift(layout.points[v])).norm());
     EXPECT_EQ(off, 0.0);
   }
+}
+
+// Shape smoothing with a floor of 1 (the guarded sweeps): a move never lowers the smallest Q
+// of its vertex's triangles, and those are the only triangles it changes, so the level's
+// smallest Q never falls, while its mean rises; nothing flips. Here a free sweep lowers it.
+TEST(BaseLevels, GuardedShapeSweepsNeverLowerTheSmallestQuality) {
+  const TriMesh input = test::capsule(6.0, 24);
+  MapsOptions maps_options;
+  maps_options.base_vertices = 20;
+  const MapsParameterization maps = maps_parameterize(input, maps_options);
+  const BaseDomain domain(maps.base);
+  const BaseLift lift(input, domain, maps.location);
+  const SubdivisionConnectivity c = subdivide_connectivity(maps.base.F, maps.base.num_vertices(), 2);
+  BaseLayout split = base_vertices_layout(domain, lift);
+  for (int j = 1; j <= 2; ++j) ASSERT_TRUE(split_on_base(c, j, domain, lift, split));
+  const RowMatrixX3i& F = c.faces[2];
+  ASSERT_EQ(count_flipped_on_base(domain, F, split.points), 0);
+  BaseSmoothingOptions sweep;
+  sweep.iterations = 1;
+  BaseLayout free_sweep = split;
+  smooth_on_base(F, domain, lift, free_sweep, sweep);
+  EXPECT_LT(smallest_q(free_sweep.X, F), smallest_q(split.X, F) - 0.05);
+
+  BaseLayout layout = split;
+  sweep.quality_floor = 1.0;
+  int moves = 0;
+  for (int i = 0; i < 6; ++i) {
+    const double smallest = smallest_q(layout.X, F);
+    moves += smooth_on_base(F, domain, lift, layout, sweep);
+    EXPECT_GE(smallest_q(layout.X, F), smallest) << "sweep " << i;
+    EXPECT_EQ(count_flipped_on_base(domain, F, layout.points), 0);
+  }
+  EXPECT_GT(moves, 0);
+  EXPECT_GT(mesh_quality(TriMesh{layout.X, F}).q_mean, mesh_quality(TriMesh{split.X, F}).q_mean + 0.01);
 }
 
 // An ellipsoid with a spike at one end of its long axis.

@@ -95,6 +95,9 @@ TEST(RemeshOptionsJson, ReportRecordsTheOptions) {
   EXPECT_EQ(report.at("options"), nlohmann::json(o));
   EXPECT_EQ(report.at("options").at("relaxation").at("lloyd_iterations"), 3);
   EXPECT_EQ(report.at("lloyd_iterations"), 3);
+  // The guarded shape sweeps run on the base-mesh domain only.
+  ASSERT_EQ(r.domain, "sphere");
+  EXPECT_EQ(report.at("guarded_shape_iterations"), 0);
 }
 
 // The command line: --config FILE, flags over the file, and a run repeated from its report.
