@@ -148,9 +148,8 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
   settings.push_back({"levels L", std::to_string(L)});
   settings.push_back({"faces (finest)", std::to_string(result.connectivity.faces.back().rows())});
   settings.push_back({"base vertices n0", std::to_string(result.levels.front().positions.rows())});
-  for (const char* key :
-       {"input", "relax", "density_exponent", "curvature_weight", "lloyd_iterations", "shape_iterations",
-        "guarded_shape_iterations"})
+  for (const char* key : {"input", "relax", "density_exponent", "curvature_weight", "lloyd_iterations",
+                          "shape_iterations", "guarded_shape_iterations"})
     if (r.is_object() && r.contains(key)) settings.push_back({key, setting(r[key])});
   if (result.parameterization.is_object())
     for (const auto& [key, value] : result.parameterization.items())

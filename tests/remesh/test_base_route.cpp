@@ -72,7 +72,7 @@ TEST(BaseDomainRemesh, ALongCapsuleNestsUnflippedAndWellShaped) {
   const nlohmann::json report = remesh_report(r, base_domain_options(4000));
   EXPECT_EQ(report["lloyd_iterations"], 0);
   EXPECT_EQ(report["options"]["relaxation"]["lloyd_iterations"], 8);  // the run, to repeat it
-  EXPECT_EQ(report["guarded_shape_iterations"], 8);  // in the Lloyd step's place
+  EXPECT_EQ(report["guarded_shape_iterations"], 8);                   // in the Lloyd step's place
   // Nor a repair of its coarse levels, whatever the option asks.
   EXPECT_EQ(report["repair_coarse_levels"], false);
   EXPECT_EQ(report["options"]["repair"]["coarse_levels"], true);
@@ -177,37 +177,56 @@ double smallest_q(const RowMatrixX3d& X, const RowMatrixX3i& F) {
   return q;
 }
 
+// A capsule's MAPS remesh split twice in the base domain, unrelaxed (every vertex at dyadic
+// barycentric coordinates of one face of K).
+struct SplitCapsule {
+  TriMesh input = test::capsule(6.0, 24);
+  MapsParameterization maps;
+  BaseDomain domain;
+  BaseLift lift;
+  SubdivisionConnectivity c;
+  BaseLayout split;
+
+  static MapsParameterization simplified(const TriMesh& input, int base_vertices) {
+    MapsOptions options;
+    options.base_vertices = base_vertices;
+    return maps_parameterize(input, options);
+  }
+  explicit SplitCapsule(int base_vertices)
+      : maps(simplified(input, base_vertices)),
+        domain(maps.base),
+        lift(input, domain, maps.location),
+        c(subdivide_connectivity(maps.base.F, maps.base.num_vertices(), 2)),
+        split(base_vertices_layout(domain, lift)) {
+    for (int j = 1; j <= 2; ++j)
+      if (!split_on_base(c, j, domain, lift, split)) throw std::logic_error("split");
+    if (count_flipped_on_base(domain, c.faces[2], split.points) != 0) throw std::logic_error("flipped");
+  }
+  const RowMatrixX3i& finest() const { return c.faces[2]; }
+};
+
 // The MAPS remesh of a capsule (the dyadic split of K, unrelaxed) has poor triangles where K's
 // faces are; the repair raises the worst of them, adds no flip in D, and leaves every vertex
 // exactly on the input (the lift of its point of D), with and without the surface guard.
 TEST(BaseLevels, RepairRaisesTheWorstQualityOnTheInputWithoutAFlip) {
-  const TriMesh input = test::capsule(6.0, 24);
-  MapsOptions maps_options;
-  maps_options.base_vertices = 40;
-  const MapsParameterization maps = maps_parameterize(input, maps_options);
-  const BaseDomain domain(maps.base);
-  const BaseLift lift(input, domain, maps.location);
-  const SubdivisionConnectivity c = subdivide_connectivity(maps.base.F, maps.base.num_vertices(), 2);
-  BaseLayout dyadic = base_vertices_layout(domain, lift);
-  for (int j = 1; j <= 2; ++j) ASSERT_TRUE(split_on_base(c, j, domain, lift, dyadic));
-  const RowMatrixX3i& F = c.faces[2];
-  ASSERT_EQ(count_flipped_on_base(domain, F, dyadic.points), 0);
-  const double before = smallest_q(dyadic.X, F);
+  const SplitCapsule capsule(40);
+  const RowMatrixX3i& F = capsule.finest();
+  const double before = smallest_q(capsule.split.X, F);
   ASSERT_LT(before, 0.5);
   for (const double tolerance : {-1.0, 0.03}) {
     SCOPED_TRACE("error tolerance " + std::to_string(tolerance));
-    BaseLayout layout = dyadic;
+    BaseLayout layout = capsule.split;
     BaseRepairOptions options;
     options.error_tolerance = tolerance;
-    const BaseRepairStats stats = repair_on_base(F, domain, lift, layout, options);
+    const BaseRepairStats stats = repair_on_base(F, capsule.domain, capsule.lift, layout, options);
     EXPECT_GT(stats.moves, 0);
     EXPECT_DOUBLE_EQ(stats.q_min_before, before);
     EXPECT_DOUBLE_EQ(stats.q_min_after, smallest_q(layout.X, F));
     EXPECT_GT(stats.q_min_after, before + 0.05) << stats.q_min_after;
-    EXPECT_EQ(count_flipped_on_base(domain, F, layout.points), 0);
+    EXPECT_EQ(count_flipped_on_base(capsule.domain, F, layout.points), 0);
     double off = 0;
     for (std::size_t v = 0; v < layout.points.size(); ++v)
-      off = std::max(off, (layout.X.row(v).transpose() - lift.lift(layout.points[v])).norm());
+      off = std::max(off, (layout.X.row(v).transpose() - capsule.lift.lift(layout.points[v])).norm());
     EXPECT_EQ(off, 0.0);
   }
 }
@@ -216,17 +235,11 @@ TEST(BaseLevels, RepairRaisesTheWorstQualityOnTheInputWithoutAFlip) {
 // of its vertex's triangles, and those are the only triangles it changes, so the level's
 // smallest Q never falls, while its mean rises; nothing flips. Here a free sweep lowers it.
 TEST(BaseLevels, GuardedShapeSweepsNeverLowerTheSmallestQuality) {
-  const TriMesh input = test::capsule(6.0, 24);
-  MapsOptions maps_options;
-  maps_options.base_vertices = 20;
-  const MapsParameterization maps = maps_parameterize(input, maps_options);
-  const BaseDomain domain(maps.base);
-  const BaseLift lift(input, domain, maps.location);
-  const SubdivisionConnectivity c = subdivide_connectivity(maps.base.F, maps.base.num_vertices(), 2);
-  BaseLayout split = base_vertices_layout(domain, lift);
-  for (int j = 1; j <= 2; ++j) ASSERT_TRUE(split_on_base(c, j, domain, lift, split));
-  const RowMatrixX3i& F = c.faces[2];
-  ASSERT_EQ(count_flipped_on_base(domain, F, split.points), 0);
+  const SplitCapsule capsule(20);
+  const BaseDomain& domain = capsule.domain;
+  const BaseLift& lift = capsule.lift;
+  const BaseLayout& split = capsule.split;
+  const RowMatrixX3i& F = capsule.finest();
   BaseSmoothingOptions sweep;
   sweep.iterations = 1;
   BaseLayout free_sweep = split;
