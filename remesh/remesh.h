@@ -93,9 +93,9 @@ struct RelaxationOptions {
   /// affine invariant, so it cannot repair shear; this can. 0 = the Lloyd step alone.
   int shape_iterations = 6;
   /// The base-mesh domain, with all_vertices: sweeps per level of the same smoothing after
-  /// those, each move refused if it lowers the smallest Q of the vertex's triangles. That
-  /// domain has no Lloyd step; these polish the shapes the free sweeps made without undoing
-  /// them anywhere. 0 = off.
+  /// those, each move refused if it lowers the smallest Q of the vertex's triangles (unless
+  /// one of them is flipped in D, which the move may then undo). That domain has no Lloyd
+  /// step; these polish the shapes the free sweeps made without undoing them anywhere. 0 = off.
   int guarded_shape_iterations = 8;
   /// With all_vertices: iterations per level of relaxation on the surface after those rounds
   /// (SmoothingTarget::area_centroid): sizes even out where the parameterization's stretch
