@@ -429,6 +429,7 @@ bool split_on_base(const SubdivisionConnectivity& connectivity, int j, const Bas
 
 int smooth_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLift& lift, BaseLayout& layout,
                    const BaseSmoothingOptions& options) {
+  if (options.iterations <= 0) return 0;  // before building the stars and the sweep's split
   const int n = static_cast<int>(layout.points.size());
   const VertexStars stars(F, n);
   const std::vector<Eigen::Vector2i> rim = rim_neighbours(boundary_edges(F, stars), n);

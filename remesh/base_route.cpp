@@ -121,11 +121,9 @@ int relax_level(const BaseContext& ctx, const RelaxationOptions& options, int j,
   shapes.iterations = options.shape_iterations;
   shapes.slide_rim = options.smooth_rim;
   int moves = smooth_on_base(F, ctx.domain, ctx.lift, layout, shapes);
-  if (options.guarded_shape_iterations > 0) {
-    shapes.iterations = options.guarded_shape_iterations;
-    shapes.quality_floor = 1.0;  // min(before, 1): never lower
-    moves += smooth_on_base(F, ctx.domain, ctx.lift, layout, shapes);
-  }
+  shapes.iterations = options.guarded_shape_iterations;
+  shapes.quality_floor = 1.0;  // min(before, 1): never lower
+  moves += smooth_on_base(F, ctx.domain, ctx.lift, layout, shapes);
   BaseSmoothingOptions sizes;
   sizes.iterations = options.surface_iterations;
   sizes.target = SmoothingTarget::area_centroid;

@@ -559,16 +559,16 @@ void measure_levels(const TriMesh& input, RemeshResult& result) {
 // has no Lloyd step in D (it relaxes by shape smoothing and area centroids) and repairs its
 // finest level only, before any projection onto the original (remesh/base_route.cpp).
 RemeshOptions options_as_run(const RemeshResult& result, RemeshOptions options) {
-  if (options.relax != RelaxMode::all_vertices || result.domain != "base_mesh")
-    options.relaxation.guarded_shape_iterations = 0;
   if (options.relax != RelaxMode::all_vertices) {
     options.relaxation.shape_iterations = 0;
+    options.relaxation.guarded_shape_iterations = 0;
     options.relaxation.surface_iterations = 0;
     options.relaxation.smooth_rim = false;
     options.snap.max_snaps = 0;
     options.fit.rounds = 0;
     options.repair.sweeps = 0;
   }
+  if (result.domain != "base_mesh") options.relaxation.guarded_shape_iterations = 0;
   if (result.domain == "base_mesh") {
     options.relaxation.lloyd_iterations = 0;
     options.repair.coarse_levels = false;

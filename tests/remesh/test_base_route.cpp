@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "mesh/distance.h"
@@ -177,30 +178,34 @@ double smallest_q(const RowMatrixX3d& X, const RowMatrixX3i& F) {
   return q;
 }
 
-// A capsule's MAPS remesh split twice in the base domain, unrelaxed (every vertex at dyadic
-// barycentric coordinates of one face of K).
-struct SplitCapsule {
-  TriMesh input = test::capsule(6.0, 24);
+// An input's MAPS remesh with `base_vertices` base vertices, split twice in the base domain;
+// each level relaxed (smooth_on_base's defaults) if `relaxed`, else every vertex at dyadic
+// barycentric coordinates of one face of K. No triangle is flipped in D.
+struct TwiceSplitLevel {
+  TriMesh input;
   MapsParameterization maps;
   BaseDomain domain;
   BaseLift lift;
   SubdivisionConnectivity c;
-  BaseLayout split;
+  BaseLayout layout;
 
   static MapsParameterization simplified(const TriMesh& input, int base_vertices) {
     MapsOptions options;
     options.base_vertices = base_vertices;
     return maps_parameterize(input, options);
   }
-  explicit SplitCapsule(int base_vertices)
-      : maps(simplified(input, base_vertices)),
+  TwiceSplitLevel(TriMesh surface, int base_vertices, bool relaxed)
+      : input(std::move(surface)),
+        maps(simplified(input, base_vertices)),
         domain(maps.base),
         lift(input, domain, maps.location),
         c(subdivide_connectivity(maps.base.F, maps.base.num_vertices(), 2)),
-        split(base_vertices_layout(domain, lift)) {
-    for (int j = 1; j <= 2; ++j)
-      if (!split_on_base(c, j, domain, lift, split)) throw std::logic_error("split");
-    if (count_flipped_on_base(domain, c.faces[2], split.points) != 0) throw std::logic_error("flipped");
+        layout(base_vertices_layout(domain, lift)) {
+    for (int j = 1; j <= 2; ++j) {
+      if (!split_on_base(c, j, domain, lift, layout)) throw std::logic_error("split");
+      if (relaxed) smooth_on_base(c.faces[j], domain, lift, layout, BaseSmoothingOptions{});
+    }
+    if (count_flipped_on_base(domain, finest(), layout.points) != 0) throw std::logic_error("flipped");
   }
   const RowMatrixX3i& finest() const { return c.faces[2]; }
 };
@@ -209,13 +214,13 @@ struct SplitCapsule {
 // faces are; the repair raises the worst of them, adds no flip in D, and leaves every vertex
 // exactly on the input (the lift of its point of D), with and without the surface guard.
 TEST(BaseLevels, RepairRaisesTheWorstQualityOnTheInputWithoutAFlip) {
-  const SplitCapsule capsule(40);
+  const TwiceSplitLevel capsule(test::capsule(6.0, 24), 40, /*relaxed=*/false);
   const RowMatrixX3i& F = capsule.finest();
-  const double before = smallest_q(capsule.split.X, F);
+  const double before = smallest_q(capsule.layout.X, F);
   ASSERT_LT(before, 0.5);
   for (const double tolerance : {-1.0, 0.03}) {
     SCOPED_TRACE("error tolerance " + std::to_string(tolerance));
-    BaseLayout layout = capsule.split;
+    BaseLayout layout = capsule.layout;
     BaseRepairOptions options;
     options.error_tolerance = tolerance;
     const BaseRepairStats stats = repair_on_base(F, capsule.domain, capsule.lift, layout, options);
@@ -235,10 +240,10 @@ TEST(BaseLevels, RepairRaisesTheWorstQualityOnTheInputWithoutAFlip) {
 // of its vertex's triangles, and those are the only triangles it changes, so the level's
 // smallest Q never falls, while its mean rises; nothing flips. Here a free sweep lowers it.
 TEST(BaseLevels, GuardedShapeSweepsNeverLowerTheSmallestQuality) {
-  const SplitCapsule capsule(20);
+  const TwiceSplitLevel capsule(test::capsule(6.0, 24), 20, /*relaxed=*/false);
   const BaseDomain& domain = capsule.domain;
   const BaseLift& lift = capsule.lift;
-  const BaseLayout& split = capsule.split;
+  const BaseLayout& split = capsule.layout;
   const RowMatrixX3i& F = capsule.finest();
   BaseSmoothingOptions sweep;
   sweep.iterations = 1;
@@ -270,30 +275,8 @@ TriMesh spiked_ellipsoid() {
 
 // That ellipsoid's MAPS remesh split twice and relaxed in the base domain: the relaxation pulls
 // the vertices off the spike, and the level cuts it off.
-struct RelaxedEllipsoidLevel {
-  TriMesh input = spiked_ellipsoid();
-  MapsParameterization maps;
-  BaseDomain domain;
-  BaseLift lift;
-  SubdivisionConnectivity c;
-  BaseLayout layout;
-
-  static MapsParameterization simplified(const TriMesh& input) {
-    MapsOptions options;
-    options.base_vertices = 30;
-    return maps_parameterize(input, options);
-  }
-  RelaxedEllipsoidLevel()
-      : maps(simplified(input)),
-        domain(maps.base),
-        lift(input, domain, maps.location),
-        c(subdivide_connectivity(maps.base.F, maps.base.num_vertices(), 2)),
-        layout(base_vertices_layout(domain, lift)) {
-    for (int j = 1; j <= 2; ++j) {
-      if (!split_on_base(c, j, domain, lift, layout)) throw std::logic_error("split");
-      smooth_on_base(c.faces[j], domain, lift, layout, BaseSmoothingOptions{});
-    }
-  }
+struct RelaxedEllipsoidLevel : TwiceSplitLevel {
+  RelaxedEllipsoidLevel() : TwiceSplitLevel(spiked_ellipsoid(), 30, /*relaxed=*/true) {}
 };
 
 // The snap in the base domain: vertices move exactly onto input vertices at their own points
