@@ -12,10 +12,11 @@
 // face count is nearest N is measured. The speed ratio compares the remeshing alone:
 // mrsnake's own time (report.json's "seconds", wall; its parallel loops use the machine's
 // threads, at most 8) against CGAL's call (one thread); the ratio to the whole command is
-// printed too. Each time is the median of --repeat runs. CGAL runs in this process (10 iterations, constraints
-// not protected) with a target edge length from the equilateral estimate, corrected once,
-// aimed at the face count of mrsnake's measured level (at N if mrsnake has none); its peak RSS is the process's
-// high-water mark during the call (reset before it).
+// printed too. Each time is the median of --repeat runs; each of CGAL's runs follows one of mrsnake's
+// (relaxed), so that a slow spell of the machine slows both alike. CGAL runs in this process (10 iterations,
+// constraints not protected) with a target edge length from the equilateral estimate, corrected once, aimed at the face
+// count of mrsnake's measured level (at N if mrsnake has none); its peak RSS is the process's high-water mark during
+// the call (reset before it).
 //
 // Inputs (default: all of them, in this order):
 // - meshes DIR/meshes/NAME.off: mushroom, heart, bear, blobby, retinal, armadillo, horse,
@@ -73,6 +74,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <optional>
@@ -165,7 +167,8 @@ int parse_count(std::string s) {
                "  --samples N       random points per face for the surface distance (default 10)\n"
                "  --iterations N    CGAL isotropic_remeshing iterations (default 10)\n"
                "  --timeout S       per mrsnake run (default 1800)\n"
-               "  --repeat N        timed runs of each method per case; medians are reported (default 3)\n"
+               "  --repeat N        timed runs of each method per case, CGAL's alternating with mrsnake's;\n"
+               "                    medians are reported (default 3)\n"
                "  --markdown FILE   also write the table as a Markdown page (commit, machine, command)\n"
                "  --config FILE     options of the mrsnake rows (mrsnake remesh --config; default: none)\n";
   std::exit(error.empty() ? 0 : 2);
@@ -395,28 +398,53 @@ CgalRun cgal_remesh_once(const TriMesh& input, double edge_length, int iteration
   return r;
 }
 
-/// Equilateral estimate: F faces of edge e cover F·(√3/4)e², so e = sqrt(4A/(√3·F)); one
-/// correction by the face count the first run gave (faces scale as 1/e²).
-CgalRun cgal_remesh(const TriMesh& input, int target_faces, int iterations, int repeat) {
-  const double e0 = std::sqrt(4.0 * total_area(input) / (std::sqrt(3.0) * target_faces));
-  const CgalRun probe = cgal_remesh_once(input, e0, iterations);
-  const double e1 = e0 * std::sqrt(static_cast<double>(probe.mesh.num_faces()) / target_faces);
-  CgalRun r = cgal_remesh_once(input, e1, iterations);
-  // The same call again (CGAL is deterministic) for the median time.
-  std::vector<double> seconds{r.seconds}, cpu_seconds{r.cpu_seconds};
-  for (int run = 1; run < repeat; ++run) {
-    const CgalRun again = cgal_remesh_once(input, e1, iterations);
-    seconds.push_back(again.seconds);
-    cpu_seconds.push_back(again.cpu_seconds);
-    r.peak_mib = std::max(r.peak_mib, again.peak_mib);
+/// CGAL's timed runs, taken one at a time so that they can alternate with mrsnake's: a slow
+/// spell of the machine then slows both methods' runs alike, not only one method's.
+class CgalTimedRuns {
+ public:
+  CgalTimedRuns(const TriMesh& input, int iterations) : input_(input), iterations_(iterations) {}
+
+  /// One timed run. The first aims the edge length at `faces` (ignored after it): the
+  /// equilateral estimate, F faces of edge e cover F·(√3/4)e², so e = sqrt(4A/(√3·F)), and one
+  /// correction by the face count an untimed probe run gave (faces scale as 1/e²).
+  void run_once(int faces) {
+    if (runs_ == 0) aim_at(faces);
+    const CgalRun again = cgal_remesh_once(input_, edge_length_, iterations_);  // CGAL is deterministic
+    if (runs_ == 0) result_ = again;
+    seconds_.push_back(again.seconds);
+    cpu_seconds_.push_back(again.cpu_seconds);
+    result_.peak_mib = std::max(result_.peak_mib, again.peak_mib);
+    ++runs_;
   }
-  r.seconds = median(seconds);
-  r.cpu_seconds = median(cpu_seconds);
-  r.probe_edge_length = e0;
-  r.probe_faces = probe.mesh.num_faces();
-  r.probe_seconds = probe.seconds;
-  return r;
-}
+
+  int runs() const { return runs_; }
+
+  /// The first run's mesh with the median times and the largest peak memory of all runs.
+  /// \pre runs() > 0
+  CgalRun result() const {
+    CgalRun r = result_;
+    r.seconds = median(seconds_);
+    r.cpu_seconds = median(cpu_seconds_);
+    r.probe_edge_length = probe_.target_edge_length;
+    r.probe_faces = probe_.mesh.num_faces();
+    r.probe_seconds = probe_.seconds;
+    return r;
+  }
+
+ private:
+  void aim_at(int faces) {
+    const double e0 = std::sqrt(4.0 * total_area(input_) / (std::sqrt(3.0) * faces));
+    probe_ = cgal_remesh_once(input_, e0, iterations_);
+    edge_length_ = e0 * std::sqrt(static_cast<double>(probe_.mesh.num_faces()) / faces);
+  }
+
+  const TriMesh& input_;
+  int iterations_;
+  int runs_ = 0;
+  double edge_length_ = 0;
+  CgalRun probe_, result_;
+  std::vector<double> seconds_, cpu_seconds_;
+};
 
 // ---------------------------------------------------------------------------------------------
 // Label-derived inputs
@@ -661,9 +689,23 @@ std::optional<double> internal_seconds(const json& report) {
   return total;
 }
 
+/// The face count of report.json's level nearest `target` (the level the row measures), or
+/// `target` if the report has no levels.
+int nearest_level_faces(const json& report, int target) {
+  int nearest = -1;
+  if (report.contains("per_level") && report["per_level"].is_array())
+    for (const auto& level : report["per_level"]) {
+      const int faces = level.value("faces", -1);
+      if (faces > 0 && (nearest < 0 || std::abs(faces - target) < std::abs(nearest - target))) nearest = faces;
+    }
+  return nearest > 0 ? nearest : target;
+}
+
 /// `reference`: what the distances are measured against (the input, or a label's mc --smooth 20 surface).
+/// `after_each_run` is called after every run that succeeded, with its report.json (null if unread).
 Row run_mrsnake_remesh(const Options& o, const std::string& name, const std::string& input_path,
-                       const TriMesh& reference, int target, bool relax, bool available) {
+                       const TriMesh& reference, int target, bool relax, bool available,
+                       const std::function<void(const json&)>& after_each_run = {}) {
   Row row;
   row.input = name;
   row.target = target;
@@ -701,16 +743,19 @@ Row run_mrsnake_remesh(const Options& o, const std::string& name, const std::str
     seconds.push_back(child.seconds);
     cpu_seconds.push_back(child.cpu_seconds);
     row.peak_mib = std::max(row.peak_mib, child.peak_mib);
+    json report;
     if (!fs::exists(dir / "report.json")) {
       row.extra["report_error"] = "report.json missing";
-      continue;
+    } else {
+      try {
+        std::ifstream in(dir / "report.json");
+        report = json::parse(in);
+        if (const auto a = internal_seconds(report)) algorithm_seconds.push_back(*a);
+      } catch (const std::exception& e) {
+        row.extra["report_error"] = e.what();
+      }
     }
-    try {
-      std::ifstream in(dir / "report.json");
-      if (const auto a = internal_seconds(json::parse(in))) algorithm_seconds.push_back(*a);
-    } catch (const std::exception& e) {
-      row.extra["report_error"] = e.what();
-    }
+    if (after_each_run) after_each_run(report);
   }
   row.extra["algorithm_runs"] = algorithm_seconds.size();
   row.seconds = median(seconds);
@@ -741,17 +786,19 @@ Row run_mrsnake_remesh(const Options& o, const std::string& name, const std::str
   return row;
 }
 
-/// CGAL aimed at `faces` (the face count mrsnake reached, so both are compared at the same
-/// size; the target N when mrsnake has no result). The row is still filed under `target`.
-/// The distances are measured against `reference`, as mrsnake's.
-Row run_cgal(const Options& o, const std::string& name, const TriMesh& input, const TriMesh& reference, int target,
-             int faces) {
+/// CGAL's row from `timed`, with the runs it still lacks (of --repeat) taken now, aimed at
+/// `faces` (the face count mrsnake reached, so both are compared at the same size; the target
+/// N when mrsnake has no result). The row is still filed under `target`. The distances are
+/// measured against `reference`, as mrsnake's.
+Row run_cgal(const Options& o, const std::string& name, const TriMesh& reference, int target, int faces,
+             CgalTimedRuns& timed) {
   Row row;
   row.input = name;
   row.target = target;
   row.method = "cgal-isotropic";
   try {
-    const CgalRun r = cgal_remesh(input, faces, o.iterations, o.repeat);
+    while (timed.runs() < o.repeat) timed.run_once(faces);
+    const CgalRun r = timed.result();
     row.seconds = r.seconds;
     row.cpu_seconds = r.cpu_seconds;
     row.peak_mib = r.peak_mib;
@@ -992,7 +1039,9 @@ void write_markdown(const Options& o, const std::vector<Row>& rows, const json& 
         "distance to it, which a remesh that follows its input does not get below. speed = CGAL's algo s / algo s (> "
         "1: faster than CGAL); cmd speed = "
         "CGAL's call / the whole mrsnake command. Times are medians of "
-     << o.repeat << " runs.\n";
+     << o.repeat
+     << " runs, each of CGAL's right after one of mrsnake's (relaxed), so that a slow spell of the "
+        "machine slows both alike.\n";
   write_text_file_atomically(o.markdown, md.str());
 }
 
@@ -1109,13 +1158,17 @@ int main(int argc, char** argv) {
     }
     inputs_json.push_back(input_json);
     for (int target : o.targets) {
-      std::cerr << label << " " << target << ": mrsnake...\n";
-      Row relaxed = run_mrsnake_remesh(o, label, path, reference, target, true, remesh_available);
+      std::cerr << label << " " << target << ": mrsnake and cgal-isotropic, run by run...\n";
+      CgalTimedRuns cgal_runs(input, o.iterations);
+      Row relaxed =
+          run_mrsnake_remesh(o, label, path, reference, target, true, remesh_available,
+                             [&](const json& report) { cgal_runs.run_once(nearest_level_faces(report, target)); });
       std::cerr << label << " " << target << ": mrsnake --no-relax...\n";
       Row plain = run_mrsnake_remesh(o, label, path, reference, target, false, remesh_available);
       const int aim = relaxed.status == "ok" ? relaxed.faces : target;
-      std::cerr << label << " " << target << ": cgal-isotropic (aiming at " << aim << " faces)...\n";
-      Row cgal = run_cgal(o, label, input, reference, target, aim);
+      if (cgal_runs.runs() < o.repeat)
+        std::cerr << label << " " << target << ": cgal-isotropic (aiming at " << aim << " faces)...\n";
+      Row cgal = run_cgal(o, label, reference, target, aim, cgal_runs);
       for (Row* r : {&relaxed, &plain})
         if (r->status == "ok" && cgal.status == "ok" && r->seconds > 0) {
           if (r->algorithm_seconds > 0) r->speed_ratio = cgal.seconds / r->algorithm_seconds;
@@ -1143,7 +1196,8 @@ int main(int argc, char** argv) {
       "threads here; CGAL: its call, one thread);\n"
       "speed = CGAL's algo_s / algo_s (> 1 is faster than CGAL); cmd_sp = CGAL's call / the whole mrsnake\n"
       "command, wall (the JSON also has the CPU ratio of the whole command).\n"
-      "Times are medians of %d runs of each method, peak memory the largest of them.\n"
+      "Times are medians of %d runs of each method, CGAL's alternating with mrsnake's; peak memory\n"
+      "the largest of them.\n"
       "targets missed (mrsnake rows): val6 >= 99 %%, angle >= 30 deg, Qmin >= 0.6, Qmean >= 0.9, RMS <= CGAL's,\n"
       "Haus <= 0.5 %%, time = algo_s < CGAL's; a row without figures misses all of them.\n\n",
       o.samples, std::min(8u, std::max(1u, std::thread::hardware_concurrency())), o.repeat);
