@@ -79,6 +79,7 @@
 #include <map>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -406,18 +407,25 @@ class CgalTimedRuns {
 
   /// One timed run. The first aims the edge length at `faces` (ignored after it): the
   /// equilateral estimate, F faces of edge e cover F·(√3/4)e², so e = sqrt(4A/(√3·F)), and one
-  /// correction by the face count an untimed probe run gave (faces scale as 1/e²).
+  /// correction by the face count an untimed probe run gave (faces scale as 1/e²). A failure
+  /// is kept (error()), not thrown: the runs are taken between mrsnake's, and end there.
   void run_once(int faces) {
-    if (runs_ == 0) aim_at(faces);
-    const CgalRun again = cgal_remesh_once(input_, edge_length_, iterations_);  // CGAL is deterministic
-    if (runs_ == 0) result_ = again;
-    seconds_.push_back(again.seconds);
-    cpu_seconds_.push_back(again.cpu_seconds);
-    result_.peak_mib = std::max(result_.peak_mib, again.peak_mib);
-    ++runs_;
+    if (!error_.empty()) return;
+    try {
+      if (runs_ == 0) aim_at(faces);
+      const CgalRun again = cgal_remesh_once(input_, edge_length_, iterations_);  // CGAL is deterministic
+      if (runs_ == 0) result_ = again;
+      seconds_.push_back(again.seconds);
+      cpu_seconds_.push_back(again.cpu_seconds);
+      result_.peak_mib = std::max(result_.peak_mib, again.peak_mib);
+      ++runs_;
+    } catch (const std::exception& e) {
+      error_ = e.what();
+    }
   }
 
   int runs() const { return runs_; }
+  const std::string& error() const { return error_; }  ///< why a run failed; empty if none did
 
   /// The first run's mesh with the median times and the largest peak memory of all runs.
   /// \pre runs() > 0
@@ -444,6 +452,7 @@ class CgalTimedRuns {
   double edge_length_ = 0;
   CgalRun probe_, result_;
   std::vector<double> seconds_, cpu_seconds_;
+  std::string error_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -797,7 +806,8 @@ Row run_cgal(const Options& o, const std::string& name, const TriMesh& reference
   row.target = target;
   row.method = "cgal-isotropic";
   try {
-    while (timed.runs() < o.repeat) timed.run_once(faces);
+    while (timed.runs() < o.repeat && timed.error().empty()) timed.run_once(faces);
+    if (!timed.error().empty()) throw std::runtime_error(timed.error());
     const CgalRun r = timed.result();
     row.seconds = r.seconds;
     row.cpu_seconds = r.cpu_seconds;
