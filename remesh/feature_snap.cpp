@@ -16,38 +16,60 @@ namespace mrsnake {
 
 namespace {
 
-// Where the input vertices stand against the level before any snap: each one's nearest level
-// face and its distance, and per level face the input vertices nearest to it (so that a snap
-// can be judged on the input around it).
+// Where the input vertices stand against the level before any snap: each one's level face
+// and its distance, and per level face the input vertices on it (so that a snap can be judged
+// on the input around it). The face is the nearest one in 3D, or the one over the input
+// vertex in D; the distance is then an upper bound (`exact` false).
 struct InputAgainstLevel {
-  std::vector<int> nearest_face;
+  std::vector<int> level_face;
   std::vector<double> distance;
   std::vector<int> under_offset, under;  ///< face f's input vertices: under[under_offset[f] ..]
   double largest = 0;
+  bool exact = true;
 };
 
-InputAgainstLevel measure_input_against_level(const RowMatrixX3d& X, const RowMatrixX3i& F,
-                                              const RowMatrixX3d& surface_V) {
-  const int m = static_cast<int>(F.rows());
+// Each input vertex's distance to its face in D, or (faces_in_domain empty) its nearest face
+// and distance by a closest-point tree over the level.
+void measure_distances(const RowMatrixX3d& X, const RowMatrixX3i& F, const RowMatrixX3d& surface_V,
+                       std::vector<int> faces_in_domain, InputAgainstLevel& input) {
   const int input_vertices = static_cast<int>(surface_V.rows());
-  InputAgainstLevel input;
-  input.nearest_face.resize(input_vertices);
   input.distance.resize(input_vertices);
+  input.exact = faces_in_domain.empty();
+  if (!input.exact) {
+    input.level_face = std::move(faces_in_domain);
+    parallel_ranges(static_cast<std::size_t>(input_vertices), [&](std::size_t begin, std::size_t end) {
+      for (auto s = static_cast<int>(begin); s < static_cast<int>(end); ++s) {
+        const int f = input.level_face[s];
+        input.distance[s] = point_triangle_distance(surface_V.row(s).transpose(), X.row(F(f, 0)).transpose(),
+                                                    X.row(F(f, 1)).transpose(), X.row(F(f, 2)).transpose());
+      }
+    });
+    return;
+  }
+  input.level_face.resize(input_vertices);
   const SurfaceLocator level(TriMesh{X, F});
   // Every input vertex is queried (90k on a liver): both cores.
   parallel_ranges(static_cast<std::size_t>(input_vertices), [&](std::size_t begin, std::size_t end) {
     for (auto s = static_cast<int>(begin); s < static_cast<int>(end); ++s) {
       const SurfaceLocator::Hit hit = level.closest(surface_V.row(s).transpose());
-      input.nearest_face[s] = hit.face;
+      input.level_face[s] = hit.face;
       input.distance[s] = hit.distance;
     }
   });
+}
+
+InputAgainstLevel measure_input_against_level(const RowMatrixX3d& X, const RowMatrixX3i& F,
+                                              const RowMatrixX3d& surface_V, std::vector<int> faces_in_domain) {
+  const int m = static_cast<int>(F.rows());
+  const int input_vertices = static_cast<int>(surface_V.rows());
+  InputAgainstLevel input;
+  measure_distances(X, F, surface_V, std::move(faces_in_domain), input);
   input.under_offset.assign(m + 1, 0);
-  for (int s = 0; s < input_vertices; ++s) ++input.under_offset[input.nearest_face[s] + 1];
+  for (int s = 0; s < input_vertices; ++s) ++input.under_offset[input.level_face[s] + 1];
   for (int f = 0; f < m; ++f) input.under_offset[f + 1] += input.under_offset[f];
   input.under.resize(input.under_offset[m]);
   std::vector<int> fill(input.under_offset.begin(), input.under_offset.end() - 1);
-  for (int s = 0; s < input_vertices; ++s) input.under[fill[input.nearest_face[s]]++] = s;
+  for (int s = 0; s < input_vertices; ++s) input.under[fill[input.level_face[s]]++] = s;
   input.largest = *std::max_element(input.distance.begin(), input.distance.end());
   return input;
 }
@@ -156,11 +178,78 @@ class SnapRegion {
   int stamp_ = 0;
 };
 
+// Exact distances from a few input points to the level (X, F), for the decisions that need
+// them: whether a point is beyond a bound. The faces around a point's level face are tried
+// first, and settle most points; the others are measured against every face, and past
+// kMaxFullScans of those against a closest-point tree (its build costs more than a few scans).
+class FewPointDistances {
+ public:
+  FewPointDistances(const RowMatrixX3d& X, const RowMatrixX3i& F, const VertexStars& stars)
+      : X_(X), F_(F), stars_(stars) {}
+
+  // p's distance to the level if it is beyond `floor`, else a distance at most `floor` (a
+  // face that near); `face` is a level face near p.
+  double distance_beyond(const Eigen::Vector3d& p, int face, double floor) {
+    for (int k = 0; k < 3; ++k) {
+      const int w = F_(face, k);
+      for (int i = stars_.offset[w]; i < stars_.offset[w + 1]; ++i) {
+        const double d = face_distance(p, stars_.faces[i]);
+        if (d <= floor) return d;
+      }
+    }
+    return distance(p);
+  }
+
+ private:
+  static constexpr int kMaxFullScans = 32;
+
+  double face_distance(const Eigen::Vector3d& p, int f) const {
+    return point_triangle_distance(p, X_.row(F_(f, 0)).transpose(), X_.row(F_(f, 1)).transpose(),
+                                   X_.row(F_(f, 2)).transpose());
+  }
+
+  double distance(const Eigen::Vector3d& p) {
+    if (full_scans_ >= kMaxFullScans) {
+      if (!tree_) tree_.emplace(TriMesh{X_, F_});
+      return tree_->closest(p).distance;
+    }
+    ++full_scans_;
+    double d = std::numeric_limits<double>::infinity();
+    for (int f = 0; f < F_.rows(); ++f) d = std::min(d, face_distance(p, f));
+    return d;
+  }
+
+  const RowMatrixX3d& X_;
+  const RowMatrixX3i& F_;
+  const VertexStars& stars_;
+  int full_scans_ = 0;
+  std::optional<SurfaceLocator> tree_;
+};
+
+// The largest input-to-level distance of (X, F), exactly. From upper bounds, only the input
+// vertices whose bound exceeds the largest distance found so far are measured, farthest first:
+// a few, where the faces in D are the nearest ones or close to them.
+double exact_largest_distance(const InputAgainstLevel& input, const RowMatrixX3d& X, const RowMatrixX3i& F,
+                              const VertexStars& stars, const RowMatrixX3d& surface_V) {
+  if (input.exact) return input.largest;
+  std::vector<int> order(input.distance.size());
+  for (std::size_t s = 0; s < order.size(); ++s) order[s] = static_cast<int>(s);
+  const std::vector<double>& bound = input.distance;
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return bound[a] > bound[b]; });
+  FewPointDistances level(X, F, stars);
+  double largest = 0;
+  for (int s : order) {
+    if (bound[s] <= largest) break;
+    largest = std::max(largest, level.distance_beyond(surface_V.row(s).transpose(), input.level_face[s], largest));
+  }
+  return largest;
+}
+
 // Whether the largest input-to-level distance, with the `moved` vertices snapped, is at most
-// `limit`: the same decision as querying the whole input, up to rounding, without querying it
-// all again. An input vertex whose nearest face did not change is at most as far as before
-// (that face is still there), so only those nearest to a changed face and those that were
-// already beyond the limit can be beyond it now.
+// `limit`: the same decision as measuring the whole input, up to rounding, without measuring
+// it all again. An input vertex whose level face did not change is at most as far as before
+// (that face is still there), so only those on a changed face and those that were already
+// beyond the limit can be beyond it now.
 bool largest_distance_within(const RowMatrixX3d& X, const RowMatrixX3i& F, const VertexStars& stars,
                              const std::vector<bool>& moved, const InputAgainstLevel& input,
                              const RowMatrixX3d& surface_V, double limit) {
@@ -168,13 +257,38 @@ bool largest_distance_within(const RowMatrixX3d& X, const RowMatrixX3i& F, const
   for (int v = 0; v < static_cast<int>(moved.size()); ++v)
     if (moved[v])
       for (int i = stars.offset[v]; i < stars.offset[v + 1]; ++i) changed[stars.faces[i]] = true;
-  std::vector<int> recheck;
+  FewPointDistances level(X, F, stars);
   for (int s = 0; s < static_cast<int>(input.distance.size()); ++s)
-    if (changed[input.nearest_face[s]] || input.distance[s] > limit) recheck.push_back(s);
-  if (recheck.empty()) return true;
-  RowMatrixX3d points(static_cast<Eigen::Index>(recheck.size()), 3);
-  for (std::size_t i = 0; i < recheck.size(); ++i) points.row(static_cast<Eigen::Index>(i)) = surface_V.row(recheck[i]);
-  return SurfaceLocator(TriMesh{X, F}).distances(points).maxCoeff() <= limit;
+    if ((changed[input.level_face[s]] || input.distance[s] > limit) &&
+        level.distance_beyond(surface_V.row(s).transpose(), input.level_face[s], limit) > limit)
+      return false;
+  return true;
+}
+
+// Each input vertex's level face in D: a walk in the level's triangulation of D from a face
+// of a level vertex that lies in one of the input vertex's faces (hints: each level vertex's
+// input face), else from the face found for the input vertex before it, so that most walks
+// take a step or two.
+template <class PointOfInput>
+std::vector<int> locate_input_in_level(const RowMatrixX3d& U, const RowMatrixX3i& F, const VertexStars& stars,
+                                       const RowMatrixX3i& input_F, int input_vertices, const std::vector<int>& hints,
+                                       const PointOfInput& point_of) {
+  std::vector<int> start_of_input_face(input_F.rows(), -1);
+  for (int v = 0; v < static_cast<int>(hints.size()); ++v)
+    if (hints[v] >= 0 && hints[v] < input_F.rows() && stars.offset[v] < stars.offset[v + 1])
+      start_of_input_face[hints[v]] = stars.faces[stars.offset[v]];
+  std::vector<int> start(input_vertices, -1);
+  for (int f = 0; f < input_F.rows(); ++f)
+    if (start_of_input_face[f] >= 0)
+      for (int k = 0; k < 3; ++k) start[input_F(f, k)] = start_of_input_face[f];
+  const DomainMesh level(U, F);
+  std::vector<int> face(input_vertices);
+  parallel_ranges(static_cast<std::size_t>(input_vertices), [&](std::size_t begin, std::size_t end) {
+    int previous = 0;
+    for (auto s = static_cast<int>(begin); s < static_cast<int>(end); ++s)
+      previous = face[s] = level.locate(point_of(s), start[s] >= 0 ? start[s] : previous).face;
+  });
+  return face;
 }
 
 }  // namespace
@@ -188,7 +302,8 @@ int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMa
   if (F.rows() == 0 || options.max_snaps <= 0) return 0;
   const VertexStars stars(F, n);
   const double threshold = options.min_distance * mean_edge_length(X, F);
-  const InputAgainstLevel input = measure_input_against_level(X, F, surface_V);
+  const InputAgainstLevel input =
+      measure_input_against_level(X, F, surface_V, domain.input_faces ? domain.input_faces() : std::vector<int>{});
   const double far_threshold = std::max(threshold, options.min_share_of_largest * input.largest);
 
   SnapRegion region(X, F, stars, input, surface_V);
@@ -243,7 +358,7 @@ int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMa
     // The nearest corner of the tip's nearest face that can take it (the nearest may be held by
     // its triangles' quality where the next one is not) the whole way, else the nearest that
     // can go part of the way, as far as the bounds allow.
-    const std::array<int, 3> corners = corners_nearest_first(X, F, input.nearest_face[s], x);
+    const std::array<int, 3> corners = corners_nearest_first(X, F, input.level_face[s], x);
     bool done = false;
     for (int phase = 0; phase < 2; ++phase)
       for (int k = 0; k < 3 && !done && judged < max_judged; ++k) {
@@ -261,7 +376,8 @@ int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMa
   // The snaps cost triangle quality: keep them only if they really bring the input closer
   // overall (the largest distance drops), not only around each snapped vertex.
   if (snaps > 0 &&
-      !largest_distance_within(X, F, stars, moved, input, surface_V, (1 - options.min_gain) * input.largest)) {
+      !largest_distance_within(X, F, stars, moved, input, surface_V,
+                               (1 - options.min_gain) * exact_largest_distance(input, X_before, F, stars, surface_V))) {
     X = X_before;
     domain.undo();
     return 0;
@@ -300,10 +416,13 @@ int snap_to_input_tips(DomainKind kind, const RowMatrixX3i& F, const DomainMesh&
     hints[v] = t == 1 ? face_of[s] : param.locate(u, hints[v]).face;
     U.row(v) = u.transpose();
   };
-  const SnapInDomain domain{toward, apply, [&] {
-                              U = U_before;
-                              hints = hints_before;
-                            }};
+  const SnapInDomain domain{
+      toward, apply,
+      [&] {
+        U = U_before;
+        hints = hints_before;
+      },
+      [&] { return locate_input_in_level(U, F, stars, PF, static_cast<int>(PD.rows()), hints, point_of); }};
   return snap_level_to_input_tips(
       F, X, surface_V, PF, disk ? boundary_vertices(F, stars) : std::vector<bool>(n, false),
       disk ? boundary_vertices(PF, static_cast<int>(PD.rows())) : std::vector<bool>(PD.rows(), false), domain, options,

@@ -14,6 +14,12 @@
 /// when its turn comes, after the snaps before it. Snaps cost triangle quality, so only tips
 /// that set the Hausdorff distance are tried, and all snaps are undone unless together they
 /// lower the largest input-to-level distance.
+///
+/// Where the domain says which level face holds each input vertex in D, the tips are found
+/// by their distance to that face: the triangle that stands for the input there, and an
+/// upper bound of the distance to the level. That needs no closest-point tree over the whole
+/// level, the larger part of the snap's time. Whether the snaps are kept is still decided on
+/// the exact largest distance.
 #include <functional>
 #include <optional>
 #include <vector>
@@ -45,6 +51,10 @@ struct SnapInDomain {
   std::function<std::optional<Eigen::Vector3d>(int v, int s, double t)> toward;
   std::function<void(int v, int s, double t)> apply;  ///< puts v there in D
   std::function<void()> undo;                         ///< puts every vertex back where it was before the snap
+  /// Each input vertex's level face in D: the face whose triangle in D holds the input
+  /// vertex's point, one entry per input vertex. Where this is empty (or gives an empty
+  /// vector) the input is measured against the level by closest point in 3D instead.
+  std::function<std::vector<int>()> input_faces;
 };
 
 /// The snap in any parameter domain: level (X, F), input vertices surface_V with faces input_F;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <string>
 #include <utility>
@@ -232,15 +233,33 @@ struct SpikedGrid {
     return true;
   }
 
-  // The snap, with v moved the fraction t of the way in the plane; the snapped mask.
-  std::pair<int, std::vector<bool>> snap(const FeatureSnapOptions& options) {
+  // Puts a second tip at `height` above the face (at(1, 1), at(2, 1), at(1, 2)), far from the first.
+  void add_tip(double height) {
+    const int a = at(1, 1), b = at(2, 1), c = at(1, 2), tip = static_cast<int>(input_V.rows());
+    input_V.conservativeResize(tip + 1, 3);
+    input_V.row(tip) = (X.row(a) + X.row(b) + X.row(c)) / 3 + Eigen::RowVector3d(0, 0, height);
+    RowMatrixX3i faces(input_F.rows() + 2, 3);
+    int rows = 0;
+    for (int f = 0; f < input_F.rows(); ++f)
+      if (input_F.row(f) != Eigen::RowVector3i(a, b, c)) faces.row(rows++) = input_F.row(f);
+    faces.row(rows++) << a, b, tip;
+    faces.row(rows++) << b, c, tip;
+    faces.row(rows++) << c, a, tip;
+    input_F = faces;
+  }
+
+  // The snap, with v moved the fraction t of the way in the plane; the snapped mask. With
+  // `input_faces`, the domain gives each input vertex's level face.
+  std::pair<int, std::vector<bool>> snap(const FeatureSnapOptions& options,
+                                         std::function<std::vector<int>()> input_faces = {}) {
     const SnapInDomain flat{[&](int v, int s, double t) -> std::optional<Eigen::Vector3d> {
                               return Eigen::Vector3d(((1 - t) * X.row(v) + t * input_V.row(s)).transpose());
                             },
-                            [](int, int, double) {}, [] {}};
+                            [](int, int, double) {}, [] {}, std::move(input_faces)};
     std::vector<bool> snapped;
-    const int snaps = snap_level_to_input_tips(F, X, input_V, input_F, boundary_vertices(F, n * n),
-                                               boundary_vertices(input_F, n * n + 1), flat, options, &snapped);
+    const int snaps =
+        snap_level_to_input_tips(F, X, input_V, input_F, boundary_vertices(F, n * n),
+                                 boundary_vertices(input_F, static_cast<int>(input_V.rows())), flat, options, &snapped);
     return {snaps, snapped};
   }
 };
@@ -286,6 +305,39 @@ TEST(FeatureSnap, ATipNoCornerCanTakeIsTakenPartOfTheWay) {
   EXPECT_TRUE(g.bounds_hold(g.nearest, part_of_the_way(t), options));
   EXPECT_FALSE(g.bounds_hold(g.nearest, part_of_the_way(t + 0.025), options));
   EXPECT_LT(SurfaceLocator(TriMesh{g.X, g.F}).closest(tip.transpose()).distance, 0.5 * before);
+}
+
+// Faces in D that overstate the distances (a rim corner of the input placed on the level's far
+// corner) may change which tips are tried, but not the decision to keep the snaps: that is made
+// on the exact largest distance. The first tip's snap is undone when a second tip, out of the
+// snap budget, stays above 3/4 of the first tip's height, and kept when it is below.
+TEST(FeatureSnap, KeepsSnapsOnTheExactLargestDistanceWhenTheFacesInDOverstateIt) {
+  const Eigen::RowVector3d tip(4.937, 2.726, 0.454);  // the snap takes it with the corner `next`
+  for (const double second_height : {0.40, 0.20})
+    for (const bool overstated : {false, true}) {
+      SCOPED_TRACE(std::to_string(second_height) + (overstated ? " overstated" : " nearest"));
+      SpikedGrid g(tip, true);
+      g.add_tip(second_height);
+      const SurfaceLocator level(TriMesh{g.X, g.F});
+      std::vector<int> faces(g.input_V.rows());
+      for (int s = 0; s < g.input_V.rows(); ++s) faces[s] = level.closest(g.input_V.row(s).transpose()).face;
+      if (overstated) faces[SpikedGrid::at(0, 0)] = static_cast<int>(g.F.rows()) - 1;
+      FeatureSnapOptions options;
+      options.max_snaps = 1;
+      options.min_share_of_largest = 0;  // the overstated largest would otherwise hide both tips
+      const RowMatrixX3d X0 = g.X;
+      const double largest = level.distances(g.input_V).maxCoeff();
+      ASSERT_DOUBLE_EQ(largest, tip.z());
+      const auto [snaps, snapped] = g.snap(options, [&] { return faces; });
+      if (second_height > (1 - options.min_gain) * largest) {
+        EXPECT_EQ(snaps, 0);
+        EXPECT_TRUE(g.X == X0);
+      } else {
+        EXPECT_EQ(snaps, 1);
+        EXPECT_TRUE(snapped[g.next]);
+        EXPECT_LE(SurfaceLocator(TriMesh{g.X, g.F}).distances(g.input_V).maxCoeff(), (1 - options.min_gain) * largest);
+      }
+    }
 }
 
 // A snap must bring the input around the vertex really closer to the level: asking for the
