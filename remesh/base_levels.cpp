@@ -369,8 +369,10 @@ int snap_on_base(const RowMatrixX3i& F, const BaseDomain& domain, const BaseLift
     if (!p || star_flips(domain, F, stars, layout, v, *p) != 0) return std::nullopt;
     return t == 1 ? Eigen::Vector3d(input_V.row(s).transpose()) : lift.lift(*p);
   };
-  const SnapInDomain moves{toward, [&](int v, int s, double t) { layout.points[v] = *point_toward(v, s, t); },
-                           [&] { layout.points = before; }};
+  const SnapInDomain moves{toward,
+                           [&](int v, int s, double t) { layout.points[v] = *point_toward(v, s, t); },
+                           [&] { layout.points = before; },
+                           {}};  // no faces in D: the tips are measured against the level in 3D
   const RowMatrixX3i& input_F = lift.input_faces();
   return snap_level_to_input_tips(F, layout.X, input_V, input_F, boundary_vertices(F, stars),
                                   boundary_vertices(input_F, static_cast<int>(input_V.rows())), moves, options,

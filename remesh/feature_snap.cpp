@@ -28,21 +28,29 @@ struct InputAgainstLevel {
   bool exact = true;
 };
 
+// p's distance to level face f of (X, F).
+double distance_to_face(const Eigen::Vector3d& p, const RowMatrixX3d& X, const RowMatrixX3i& F, int f) {
+  return point_triangle_distance(p, X.row(F(f, 0)).transpose(), X.row(F(f, 1)).transpose(), X.row(F(f, 2)).transpose());
+}
+
+// Whether `faces` gives every input vertex a face of F (else the tree measures the input).
+bool one_face_per_input_vertex(const std::vector<int>& faces, const RowMatrixX3i& F, Eigen::Index input_vertices) {
+  return static_cast<Eigen::Index>(faces.size()) == input_vertices &&
+         std::all_of(faces.begin(), faces.end(), [&](int f) { return f >= 0 && f < F.rows(); });
+}
+
 // Each input vertex's distance to its face in D, or (faces_in_domain empty) its nearest face
 // and distance by a closest-point tree over the level.
 void measure_distances(const RowMatrixX3d& X, const RowMatrixX3i& F, const RowMatrixX3d& surface_V,
                        std::vector<int> faces_in_domain, InputAgainstLevel& input) {
   const int input_vertices = static_cast<int>(surface_V.rows());
   input.distance.resize(input_vertices);
-  input.exact = faces_in_domain.empty();
+  input.exact = !one_face_per_input_vertex(faces_in_domain, F, surface_V.rows());
   if (!input.exact) {
     input.level_face = std::move(faces_in_domain);
     parallel_ranges(static_cast<std::size_t>(input_vertices), [&](std::size_t begin, std::size_t end) {
-      for (auto s = static_cast<int>(begin); s < static_cast<int>(end); ++s) {
-        const int f = input.level_face[s];
-        input.distance[s] = point_triangle_distance(surface_V.row(s).transpose(), X.row(F(f, 0)).transpose(),
-                                                    X.row(F(f, 1)).transpose(), X.row(F(f, 2)).transpose());
-      }
+      for (auto s = static_cast<int>(begin); s < static_cast<int>(end); ++s)
+        input.distance[s] = distance_to_face(surface_V.row(s).transpose(), X, F, input.level_face[s]);
     });
     return;
   }
@@ -193,7 +201,7 @@ class FewPointDistances {
     for (int k = 0; k < 3; ++k) {
       const int w = F_(face, k);
       for (int i = stars_.offset[w]; i < stars_.offset[w + 1]; ++i) {
-        const double d = face_distance(p, stars_.faces[i]);
+        const double d = distance_to_face(p, X_, F_, stars_.faces[i]);
         if (d <= floor) return d;
       }
     }
@@ -203,11 +211,6 @@ class FewPointDistances {
  private:
   static constexpr int kMaxFullScans = 32;
 
-  double face_distance(const Eigen::Vector3d& p, int f) const {
-    return point_triangle_distance(p, X_.row(F_(f, 0)).transpose(), X_.row(F_(f, 1)).transpose(),
-                                   X_.row(F_(f, 2)).transpose());
-  }
-
   double distance(const Eigen::Vector3d& p) {
     if (full_scans_ >= kMaxFullScans) {
       if (!tree_) tree_.emplace(TriMesh{X_, F_});
@@ -215,7 +218,7 @@ class FewPointDistances {
     }
     ++full_scans_;
     double d = std::numeric_limits<double>::infinity();
-    for (int f = 0; f < F_.rows(); ++f) d = std::min(d, face_distance(p, f));
+    for (int f = 0; f < F_.rows(); ++f) d = std::min(d, distance_to_face(p, X_, F_, f));
     return d;
   }
 
@@ -299,12 +302,14 @@ int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMa
                              const FeatureSnapOptions& options, std::vector<bool>* snapped) {
   const int n = static_cast<int>(X.rows());
   if (snapped) snapped->assign(n, false);
-  if (F.rows() == 0 || options.max_snaps <= 0) return 0;
+  if (F.rows() == 0 || surface_V.rows() == 0 || options.max_snaps <= 0) return 0;
   const VertexStars stars(F, n);
   const double threshold = options.min_distance * mean_edge_length(X, F);
   const InputAgainstLevel input =
       measure_input_against_level(X, F, surface_V, domain.input_faces ? domain.input_faces() : std::vector<int>{});
-  const double far_threshold = std::max(threshold, options.min_share_of_largest * input.largest);
+  // Exact, so that an overstated bound hides no tip and loosens no decision.
+  const double largest = exact_largest_distance(input, X, F, stars, surface_V);
+  const double far_threshold = std::max(threshold, options.min_share_of_largest * largest);
 
   SnapRegion region(X, F, stars, input, surface_V);
   std::vector<bool> moved(n, false);
@@ -355,7 +360,7 @@ int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMa
   for (int s : far_tips(input, far_threshold, input_F, input_rim)) {
     if (snaps >= options.max_snaps || judged >= max_judged) break;
     const Eigen::Vector3d x = surface_V.row(s).transpose();
-    // The nearest corner of the tip's nearest face that can take it (the nearest may be held by
+    // The nearest corner of the tip's level face that can take it (the nearest may be held by
     // its triangles' quality where the next one is not) the whole way, else the nearest that
     // can go part of the way, as far as the bounds allow.
     const std::array<int, 3> corners = corners_nearest_first(X, F, input.level_face[s], x);
@@ -375,9 +380,7 @@ int snap_level_to_input_tips(const RowMatrixX3i& F, RowMatrixX3d& X, const RowMa
   }
   // The snaps cost triangle quality: keep them only if they really bring the input closer
   // overall (the largest distance drops), not only around each snapped vertex.
-  if (snaps > 0 &&
-      !largest_distance_within(X, F, stars, moved, input, surface_V,
-                               (1 - options.min_gain) * exact_largest_distance(input, X_before, F, stars, surface_V))) {
+  if (snaps > 0 && !largest_distance_within(X, F, stars, moved, input, surface_V, (1 - options.min_gain) * largest)) {
     X = X_before;
     domain.undo();
     return 0;

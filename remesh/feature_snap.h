@@ -8,7 +8,7 @@
 /// vertex's triangles with Q >= min_quality and angles >= min_angle_deg, and really brings the
 /// input around the vertex closer to the level (moving a vertex onto a tip also moves its
 /// triangles off the input it stood on). Where the nearest vertex cannot take the tip, the
-/// other corners of the tip's nearest face are tried; where none can, the nearest corner that
+/// other corners of the tip's level face are tried; where none can, the nearest corner that
 /// can go part of the way (from 1/4, in D) goes as far as the bounds allow, which still lowers
 /// the tip's distance. A tip is judged by its distance to the level as it is
 /// when its turn comes, after the snaps before it. Snaps cost triangle quality, so only tips
@@ -18,8 +18,9 @@
 /// Where the domain says which level face holds each input vertex in D, the tips are found
 /// by their distance to that face: the triangle that stands for the input there, and an
 /// upper bound of the distance to the level. That needs no closest-point tree over the whole
-/// level, the larger part of the snap's time. Whether the snaps are kept is still decided on
-/// the exact largest distance.
+/// level, the larger part of the snap's time. How far a tip must be, and whether the snaps are
+/// kept, are still decided on the exact largest distance, measured for the few input vertices
+/// whose bound exceeds it.
 #include <functional>
 #include <optional>
 #include <vector>
@@ -35,7 +36,7 @@ struct FeatureSnapOptions {
   double min_quality = 0.65;  ///< the moved vertex's triangles keep Q >= this
   double min_angle_deg = 32;  ///< and angles >= this (the repair after it keeps snapped tips fixed)
   /// A snap of v must lower the largest distance from the input vertices near v (those whose
-  /// nearest level face is around v or its neighbours) to the level by at least this fraction,
+  /// level face is around v or its neighbours) to the level by at least this fraction,
   /// and all snaps together the largest distance from the whole input.
   double min_gain = 0.25;
   /// Only tips at least this fraction of the largest input-to-level distance away: the ones
@@ -52,8 +53,10 @@ struct SnapInDomain {
   std::function<void(int v, int s, double t)> apply;  ///< puts v there in D
   std::function<void()> undo;                         ///< puts every vertex back where it was before the snap
   /// Each input vertex's level face in D: the face whose triangle in D holds the input
-  /// vertex's point, one entry per input vertex. Where this is empty (or gives an empty
-  /// vector) the input is measured against the level by closest point in 3D instead.
+  /// vertex's point (on a disk, outside the level's rim chords, the rim face nearest it), one
+  /// entry per input vertex. Where this is empty, or gives anything but one face of the level
+  /// per input vertex, the input is measured against the level by closest point in 3D
+  /// instead: each input vertex's level face is then its nearest.
   std::function<std::vector<int>()> input_faces;
 };
 

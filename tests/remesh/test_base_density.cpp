@@ -307,10 +307,11 @@ TEST(FeatureSnap, ATipNoCornerCanTakeIsTakenPartOfTheWay) {
   EXPECT_LT(SurfaceLocator(TriMesh{g.X, g.F}).closest(tip.transpose()).distance, 0.5 * before);
 }
 
-// Faces in D that overstate the distances (a rim corner of the input placed on the level's far
-// corner) may change which tips are tried, but not the decision to keep the snaps: that is made
-// on the exact largest distance. The first tip's snap is undone when a second tip, out of the
-// snap budget, stays above 3/4 of the first tip's height, and kept when it is below.
+// Faces in D that overstate the distances (a rim corner of the input given the face at the
+// level's far corner, 21 times the largest distance away) change neither which tips are far
+// enough to try nor the decision to keep the snaps: both are made on the exact largest
+// distance. The first tip's snap is undone when a second tip, out of the snap budget, stays
+// above 3/4 of the first tip's height, and kept when it is below.
 TEST(FeatureSnap, KeepsSnapsOnTheExactLargestDistanceWhenTheFacesInDOverstateIt) {
   const Eigen::RowVector3d tip(4.937, 2.726, 0.454);  // the snap takes it with the corner `next`
   for (const double second_height : {0.40, 0.20})
@@ -324,7 +325,6 @@ TEST(FeatureSnap, KeepsSnapsOnTheExactLargestDistanceWhenTheFacesInDOverstateIt)
       if (overstated) faces[SpikedGrid::at(0, 0)] = static_cast<int>(g.F.rows()) - 1;
       FeatureSnapOptions options;
       options.max_snaps = 1;
-      options.min_share_of_largest = 0;  // the overstated largest would otherwise hide both tips
       const RowMatrixX3d X0 = g.X;
       const double largest = level.distances(g.input_V).maxCoeff();
       ASSERT_DOUBLE_EQ(largest, tip.z());
