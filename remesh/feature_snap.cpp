@@ -39,8 +39,8 @@ bool one_face_per_input_vertex(const std::vector<int>& faces, const RowMatrixX3i
          std::all_of(faces.begin(), faces.end(), [&](int f) { return f >= 0 && f < F.rows(); });
 }
 
-// Each input vertex's distance to its face in D, or (faces_in_domain empty) its nearest face
-// and distance by a closest-point tree over the level.
+// Each input vertex's distance to its face in D, or (faces_in_domain not one level face per
+// input vertex, as when empty) its nearest face and distance by a closest-point tree.
 void measure_distances(const RowMatrixX3d& X, const RowMatrixX3i& F, const RowMatrixX3d& surface_V,
                        std::vector<int> faces_in_domain, InputAgainstLevel& input) {
   const int input_vertices = static_cast<int>(surface_V.rows());
