@@ -229,21 +229,27 @@ class FewPointDistances {
   std::optional<SurfaceLocator> tree_;
 };
 
-// The largest input-to-level distance of (X, F), exactly. From upper bounds, only the input
-// vertices whose bound exceeds the largest distance found so far are measured, farthest first:
-// a few, where the faces in D are the nearest ones or close to them.
+// The largest input-to-level distance of (X, F), exactly. From upper bounds: the vertex of the
+// largest bound is measured, and then only those whose bound exceeds the largest distance
+// found so far, farthest first: a few, where the faces in D are the nearest ones or close to
+// them (so only those few are sorted, not the whole input).
 double exact_largest_distance(const InputAgainstLevel& input, const RowMatrixX3d& X, const RowMatrixX3i& F,
                               const VertexStars& stars, const RowMatrixX3d& surface_V) {
   if (input.exact) return input.largest;
-  std::vector<int> order(input.distance.size());
-  for (std::size_t s = 0; s < order.size(); ++s) order[s] = static_cast<int>(s);
   const std::vector<double>& bound = input.distance;
-  std::sort(order.begin(), order.end(), [&](int a, int b) { return bound[a] > bound[b]; });
   FewPointDistances level(X, F, stars);
-  double largest = 0;
-  for (int s : order) {
+  const auto measure = [&](int s, double floor) {
+    return level.distance_beyond(surface_V.row(s).transpose(), input.level_face[s], floor);
+  };
+  const auto farthest = static_cast<int>(std::max_element(bound.begin(), bound.end()) - bound.begin());
+  double largest = measure(farthest, 0);
+  std::vector<int> above;
+  for (int s = 0; s < static_cast<int>(bound.size()); ++s)
+    if (bound[s] > largest && s != farthest) above.push_back(s);
+  std::sort(above.begin(), above.end(), [&](int a, int b) { return bound[a] > bound[b]; });
+  for (int s : above) {
     if (bound[s] <= largest) break;
-    largest = std::max(largest, level.distance_beyond(surface_V.row(s).transpose(), input.level_face[s], largest));
+    largest = std::max(largest, measure(s, largest));
   }
   return largest;
 }
