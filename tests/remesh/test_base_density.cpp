@@ -307,22 +307,28 @@ TEST(FeatureSnap, ATipNoCornerCanTakeIsTakenPartOfTheWay) {
   EXPECT_LT(SurfaceLocator(TriMesh{g.X, g.F}).closest(tip.transpose()).distance, 0.5 * before);
 }
 
-// Faces in D that overstate the distances (a rim corner of the input given the face at the
-// level's far corner, 21 times the largest distance away) change neither which tips are far
-// enough to try nor the decision to keep the snaps: both are made on the exact largest
-// distance. The first tip's snap is undone when a second tip, out of the snap budget, stays
-// above 3/4 of the first tip's height, and kept when it is below.
+// Faces in D that overstate the distances change neither which tips are far enough to try nor
+// the decision to keep the snaps: both are made on the exact largest distance. The faces are
+// the nearest ones; or a rim corner of the input is given the face at the level's far corner,
+// 21 times the largest distance away; or every input vertex but the two tips is, so that
+// measuring the exact largest distance takes more than the 32 scans of the whole level after
+// which it builds a closest-point tree. The first tip's snap is undone when a second tip, out
+// of the snap budget, stays above 3/4 of the first tip's height, and kept when it is below.
 TEST(FeatureSnap, KeepsSnapsOnTheExactLargestDistanceWhenTheFacesInDOverstateIt) {
+  enum class Faces { nearest, one_overstated, all_but_the_tips_overstated };
   const Eigen::RowVector3d tip(4.937, 2.726, 0.454);  // the snap takes it with the corner `next`
   for (const double second_height : {0.40, 0.20})
-    for (const bool overstated : {false, true}) {
-      SCOPED_TRACE(std::to_string(second_height) + (overstated ? " overstated" : " nearest"));
+    for (const Faces given : {Faces::nearest, Faces::one_overstated, Faces::all_but_the_tips_overstated}) {
+      SCOPED_TRACE(std::to_string(second_height) + " faces " + std::to_string(static_cast<int>(given)));
       SpikedGrid g(tip, true);
       g.add_tip(second_height);
       const SurfaceLocator level(TriMesh{g.X, g.F});
+      const int far_corner_face = static_cast<int>(g.F.rows()) - 1;
       std::vector<int> faces(g.input_V.rows());
       for (int s = 0; s < g.input_V.rows(); ++s) faces[s] = level.closest(g.input_V.row(s).transpose()).face;
-      if (overstated) faces[SpikedGrid::at(0, 0)] = static_cast<int>(g.F.rows()) - 1;
+      if (given == Faces::one_overstated) faces[SpikedGrid::at(0, 0)] = far_corner_face;
+      if (given == Faces::all_but_the_tips_overstated)
+        for (int s = 0; s < g.tip_vertex; ++s) faces[s] = far_corner_face;
       FeatureSnapOptions options;
       options.max_snaps = 1;
       const RowMatrixX3d X0 = g.X;
