@@ -199,14 +199,19 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
   const auto clock_start = Clock::now();
   const RowMatrixX3i& F = ctx.connectivity.faces[j];
   const bool full = options.relax == RelaxMode::all_vertices;
-  LaidOutLevel laid_out = lay_out_level(ctx, options, j, start);
+  nlohmann::json stage_seconds = nlohmann::json::object();
+  LaidOutLevel laid_out = timed(stage_seconds, "lay_out", [&] { return lay_out_level(ctx, options, j, start); });
   BaseLayout& layout = laid_out.layout;
   // The finest level's tips first, then its worst triangles around them (the snapped stay).
   std::vector<bool> snapped(layout.points.size(), false);
-  const int snaps = full && options.snap.max_snaps > 0 && j == ctx.connectivity.levels()
-                        ? snap_on_base(F, ctx.domain, ctx.lift, layout, options.snap, &snapped)
-                        : 0;
-  const nlohmann::json repair = full ? repair_level_on_base(ctx, options.repair, j, snapped, layout) : nlohmann::json();
+  int snaps = 0;
+  if (full && options.snap.max_snaps > 0 && j == ctx.connectivity.levels())
+    snaps = timed(stage_seconds, "snap",
+                  [&] { return snap_on_base(F, ctx.domain, ctx.lift, layout, options.snap, &snapped); });
+  nlohmann::json repair;
+  if (full)
+    repair =
+        timed(stage_seconds, "repair", [&] { return repair_level_on_base(ctx, options.repair, j, snapped, layout); });
   RemeshLevel level;
   level.positions = layout.X;
   if (ctx.reproject) reproject_onto(*ctx.reproject, level.positions);
@@ -218,7 +223,8 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
   if (full && options.fit.rounds > 0 && j == ctx.connectivity.levels() && ctx.locator) {
     std::vector<bool> fixed = boundary_vertices(F, static_cast<int>(level.positions.rows()));
     for (std::size_t v = 0; v < fixed.size(); ++v) fixed[v] = fixed[v] || snapped[v];  // the tips stay on the input
-    const SurfaceFitStats s = fit_to_surface(F, level.positions, *ctx.locator, options.fit, fixed);
+    const SurfaceFitStats s = timed(
+        stage_seconds, "fit", [&] { return fit_to_surface(F, level.positions, *ctx.locator, options.fit, fixed); });
     fit = {{"rms_before_mm", s.rms_before}, {"rms_after_mm", s.rms_after}, {"max_offset_mm", s.max_offset}};
   }
   level.domain_positions.resize(layout.points.size(), 3);
@@ -233,6 +239,7 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
                  {"flipped_triangles", flipped},
                  {"seconds", level.seconds},
                  {"shape_moves", laid_out.moves},
+                 {"stage_seconds", stage_seconds},
                  {"started_from", laid_out.from_dyadic ? "dyadic split" : "relaxed split"}};
   if (!fit.is_null()) level.stats["fit"] = fit;
   if (!repair.is_null()) level.stats["repair"] = repair;

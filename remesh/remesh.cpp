@@ -290,6 +290,7 @@ struct LevelRecord {
   TriangleRepairStats repair;
   bool fitted = false;
   SurfaceFitStats fit;
+  nlohmann::json stage_seconds = nlohmann::json::object();  ///< per stage that ran, in run order
 };
 
 nlohmann::json level_stats(int j, const RemeshLevel& level, const RowMatrixX3i& F, const LevelRecord& r) {
@@ -305,6 +306,7 @@ nlohmann::json level_stats(int j, const RemeshLevel& level, const RowMatrixX3i& 
   s["shape_moves"] = r.relax.shape_moves;
   s["repair_moves"] = r.repair.moves;
   s["snapped_vertices"] = r.snapped;
+  s["stage_seconds"] = r.stage_seconds;
   if (r.fitted)
     s["fit"] = {{"rms_before_mm", r.fit.rms_before},          {"rms_after_mm", r.fit.rms_after},
                 {"mean_offset_mm", r.fit.mean_offset},        {"max_offset_mm", r.fit.max_offset},
@@ -326,22 +328,27 @@ RemeshLevel build_level(const LevelContext& ctx, const RemeshOptions& options, i
   const RowMatrixX3i& F = ctx.connectivity.faces[j];
   const bool finest = j == ctx.connectivity.levels();
   const bool full = options.relax == RelaxMode::all_vertices;
-  if (j > 0) split_level(ctx.connectivity, j, ctx.kind, layout);
   RemeshLevel level;
   LevelRecord r;
-  r.relax = relax_in_domain(ctx, options.relax, options.relaxation, j, layout, level.positions);
+  nlohmann::json& stage = r.stage_seconds;
+  if (j > 0) timed(stage, "split", [&] { split_level(ctx.connectivity, j, ctx.kind, layout); });
+  r.relax = timed(stage, "relax_in_domain",
+                  [&] { return relax_in_domain(ctx, options.relax, options.relaxation, j, layout, level.positions); });
   if (full && options.relaxation.surface_iterations > 0)
-    r.relax.shape_moves += relax_on_surface(ctx, options.relaxation, j, layout, level.positions);
+    r.relax.shape_moves += timed(stage, "relax_on_surface",
+                                 [&] { return relax_on_surface(ctx, options.relaxation, j, layout, level.positions); });
   std::vector<bool> snapped;
   if (full && options.snap.max_snaps > 0 && finest)
-    r.snapped = snap_tips(ctx, options.snap, j, layout, level.positions, snapped);
+    r.snapped = timed(stage, "snap", [&] { return snap_tips(ctx, options.snap, j, layout, level.positions, snapped); });
   // Onto the original input before the repair, so that the repair sees (and keeps) the final
   // triangles: the projection onto a marching-cubes staircase shears a few of them.
   const bool project_first = ctx.reproject && options.repair.after_reprojection;
   if (project_first) reproject_onto(*ctx.reproject, level.positions);
   if (full && options.repair.sweeps > 0 && (options.repair.coarse_levels || finest))
-    r.repair = repair_level(ctx, options.repair, j, project_first, r.snapped > 0 ? &snapped : nullptr, layout,
-                            level.positions);
+    r.repair = timed(stage, "repair", [&] {
+      return repair_level(ctx, options.repair, j, project_first, r.snapped > 0 ? &snapped : nullptr, layout,
+                          level.positions);
+    });
   report(options.progress, "level " + std::to_string(j), 0.5);
   if (ctx.reproject && !project_first) reproject_onto(*ctx.reproject, level.positions);
   const int flipped = count_flipped(layout.U, F);
@@ -349,7 +356,8 @@ RemeshLevel build_level(const LevelContext& ctx, const RemeshOptions& options, i
     throw AlgorithmError("level " + std::to_string(j) + " has " + std::to_string(flipped) +
                          " flipped triangles in the domain; the surface cannot be remeshed well");
   r.fitted = ctx.fit_rounds > 0 && finest;
-  if (r.fitted) r.fit = fit_finest(ctx, options.fit, j, snapped, r.snapped, level.positions);
+  if (r.fitted)
+    r.fit = timed(stage, "fit", [&] { return fit_finest(ctx, options.fit, j, snapped, r.snapped, level.positions); });
   level.domain_positions = layout.U;
   level.flipped_triangles = flipped;
   level.seconds = seconds_since(start) + extra_seconds;

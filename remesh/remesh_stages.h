@@ -5,6 +5,7 @@
 /// level. Internal to the remesh module.
 #include <chrono>
 #include <memory>
+#include <type_traits>
 #include <utility>
 
 #include <nlohmann/json.hpp>
@@ -20,6 +21,22 @@ namespace mrsnake::remesh_stages {
 using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start);
+
+/// Runs `stage`, adds its wall time to `seconds[name]` (a level's `stage_seconds`), and
+/// returns what it returns.
+template <typename Stage>
+auto timed(nlohmann::json& seconds, const char* name, Stage&& stage) {
+  const auto start = Clock::now();
+  const auto add_time = [&] { seconds[name] = seconds.value(name, 0.0) + seconds_since(start); };
+  if constexpr (std::is_void_v<std::invoke_result_t<Stage>>) {
+    stage();
+    add_time();
+  } else {
+    auto result = stage();
+    add_time();
+    return result;
+  }
+}
 
 /// The hierarchy's shape: L levels of 1:4 splits over a base of n0 vertices.
 struct Resolution {
