@@ -290,7 +290,7 @@ struct LevelRecord {
   TriangleRepairStats repair;
   bool fitted = false;
   SurfaceFitStats fit;
-  nlohmann::json stage_seconds = nlohmann::json::object();  ///< per stage that ran, in run order
+  nlohmann::json stage_seconds = nlohmann::json::object();  ///< per stage that ran
 };
 
 nlohmann::json level_stats(int j, const RemeshLevel& level, const RowMatrixX3i& F, const LevelRecord& r) {
