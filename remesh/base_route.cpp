@@ -209,7 +209,7 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
     snaps = timed(stage_seconds, "snap",
                   [&] { return snap_on_base(F, ctx.domain, ctx.lift, layout, options.snap, &snapped); });
   nlohmann::json repair;
-  if (full)
+  if (full && options.repair.sweeps > 0 && j == ctx.connectivity.levels())  // as repair_level_on_base runs
     repair =
         timed(stage_seconds, "repair", [&] { return repair_level_on_base(ctx, options.repair, j, snapped, layout); });
   RemeshLevel level;

@@ -312,8 +312,9 @@ TEST(FeatureSnap, ATipNoCornerCanTakeIsTakenPartOfTheWay) {
 // the nearest ones; or a rim corner of the input is given the face at the level's far corner,
 // 21 times the largest distance away; or every input vertex but the two tips is, so that
 // measuring the exact largest distance takes more than the 32 scans of the whole level after
-// which it builds a closest-point tree. The first tip's snap is undone when a second tip, out
-// of the snap budget, stays above 3/4 of the first tip's height, and kept when it is below.
+// which it builds a closest-point tree (that face's corners are on the level's rim, so no snap
+// is tried from them). The first tip's snap is undone when a second tip, out of the snap
+// budget, stays above 3/4 of the first tip's height, and kept when it is below.
 TEST(FeatureSnap, KeepsSnapsOnTheExactLargestDistanceWhenTheFacesInDOverstateIt) {
   enum class Faces { nearest, one_overstated, all_but_the_tips_overstated };
   const Eigen::RowVector3d tip(4.937, 2.726, 0.454);  // the snap takes it with the corner `next`

@@ -591,6 +591,7 @@ TEST(RemeshCli, WritesNestedLevelsAndReport) {
       EXPECT_TRUE(level.contains(key)) << key;
     // The stages' times are parts of the level's.
     double stages = 0;
+    ASSERT_TRUE(level.contains("stage_seconds"));
     for (const auto& [stage, seconds] : level["stage_seconds"].items()) {
       EXPECT_GE(seconds.get<double>(), 0.0) << stage;
       stages += seconds.get<double>();
