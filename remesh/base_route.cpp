@@ -176,11 +176,10 @@ LaidOutLevel lay_out_level(const BaseContext& ctx, const RemeshOptions& options,
 // repairs them, with the surface guard. Coarse levels are not repaired here (whatever
 // options.coarse_levels says): the next level's relaxation starts from them, and repairing them
 // measured worse at the finest level (human at 16k faces: Q mean 0.831 -> 0.810; horse at 16k:
-// Hausdorff distance 0.50 -> 0.94 % of the diagonal). Returns its record (null if it did not run).
+// Hausdorff distance 0.50 -> 0.94 % of the diagonal). Returns its record.
+// \pre j is the finest level and options.sweeps > 0 (the caller runs it only there).
 nlohmann::json repair_level_on_base(const BaseContext& ctx, const RepairOptions& options, int j,
                                     const std::vector<bool>& snapped, BaseLayout& layout) {
-  const bool finest = j == ctx.connectivity.levels();
-  if (options.sweeps <= 0 || !finest) return nullptr;
   BaseRepairOptions repair;
   repair.fixed = &snapped;
   repair.sweeps = options.sweeps;
@@ -198,18 +197,19 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
                              double extra_seconds) {
   const auto clock_start = Clock::now();
   const RowMatrixX3i& F = ctx.connectivity.faces[j];
-  const bool full = options.relax == RelaxMode::all_vertices;
+  // The snap, the repair and the fit run on the finest level, and with the full method only.
+  const bool finest_full = options.relax == RelaxMode::all_vertices && j == ctx.connectivity.levels();
   nlohmann::json stage_seconds = nlohmann::json::object();
   LaidOutLevel laid_out = timed(stage_seconds, "lay_out", [&] { return lay_out_level(ctx, options, j, start); });
   BaseLayout& layout = laid_out.layout;
   // The finest level's tips first, then its worst triangles around them (the snapped stay).
   std::vector<bool> snapped(layout.points.size(), false);
   int snaps = 0;
-  if (full && options.snap.max_snaps > 0 && j == ctx.connectivity.levels())
+  if (finest_full && options.snap.max_snaps > 0)
     snaps = timed(stage_seconds, "snap",
                   [&] { return snap_on_base(F, ctx.domain, ctx.lift, layout, options.snap, &snapped); });
   nlohmann::json repair;
-  if (full && options.repair.sweeps > 0 && j == ctx.connectivity.levels())  // as repair_level_on_base runs
+  if (finest_full && options.repair.sweeps > 0)
     repair =
         timed(stage_seconds, "repair", [&] { return repair_level_on_base(ctx, options.repair, j, snapped, layout); });
   RemeshLevel level;
@@ -220,7 +220,7 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
     throw AlgorithmError("level " + std::to_string(j) + " has " + std::to_string(flipped) +
                          " flipped triangles in the base domain; the surface cannot be remeshed well");
   nlohmann::json fit;
-  if (full && options.fit.rounds > 0 && j == ctx.connectivity.levels() && ctx.locator) {
+  if (finest_full && options.fit.rounds > 0 && ctx.locator) {
     std::vector<bool> fixed = boundary_vertices(F, static_cast<int>(level.positions.rows()));
     for (std::size_t v = 0; v < fixed.size(); ++v) fixed[v] = fixed[v] || snapped[v];  // the tips stay on the input
     const SurfaceFitStats s = timed(

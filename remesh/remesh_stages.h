@@ -22,18 +22,17 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start);
 
-/// Runs `stage`, adds its wall time to `seconds[name]` (a level's `stage_seconds`), and
+/// Runs `stage`, records its wall time as `seconds[name]` (a level's `stage_seconds`), and
 /// returns what it returns.
 template <typename Stage>
 auto timed(nlohmann::json& seconds, const char* name, Stage&& stage) {
   const auto start = Clock::now();
-  const auto add_time = [&] { seconds[name] = seconds.value(name, 0.0) + seconds_since(start); };
   if constexpr (std::is_void_v<std::invoke_result_t<Stage>>) {
     stage();
-    add_time();
+    seconds[name] = seconds_since(start);
   } else {
     auto result = stage();
-    add_time();
+    seconds[name] = seconds_since(start);
     return result;
   }
 }

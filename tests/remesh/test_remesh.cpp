@@ -586,12 +586,12 @@ TEST(RemeshCli, WritesNestedLevelsAndReport) {
   const auto report = nlohmann::json::parse(in);
   ASSERT_EQ(report["per_level"].size(), 3u);
   for (const auto& level : report["per_level"]) {
-    for (const char* key : {"vertices", "faces", "flipped_triangles", "self_intersections", "seconds", "stage_seconds",
-                            "quality", "distance"})
+    for (const char* key :
+         {"vertices", "faces", "flipped_triangles", "self_intersections", "seconds", "quality", "distance"})
       EXPECT_TRUE(level.contains(key)) << key;
     // The stages' times are parts of the level's.
-    double stages = 0;
     ASSERT_TRUE(level.contains("stage_seconds"));
+    double stages = 0;
     for (const auto& [stage, seconds] : level["stage_seconds"].items()) {
       EXPECT_GE(seconds.get<double>(), 0.0) << stage;
       stages += seconds.get<double>();
