@@ -491,22 +491,29 @@ Eigen::Vector3d mobius_to_center(const Eigen::Vector3d& a, const Eigen::Vector3d
   return (1.0 - a.squaredNorm()) * d / d.squaredNorm() - a;
 }
 
+bool OneChartFailure::squeezed() const { return !(stretch_spread_log10 <= max_stretch_spread_log10); }
+
 namespace {
 
 // A one-chart map that flipped triangles or squeezed a protrusion past what doubles resolve is
 // replaced by the hierarchical one, which bounds the squeeze at the price of anisotropy: the
 // one-chart maps stay first, being conformal, where they work.
+// \throw AlgorithmError if options.on_hierarchical_fallback declines the hierarchical map.
 void fall_back_to_hierarchical_map(const TriMesh& mesh, const ParameterizationOptions& options,
                                    Parameterization& param) {
-  const int flipped = count_flipped(param.domain, mesh.F);
-  const double spread = stretch_spread_log10(mesh, param.domain);
-  if (flipped == 0 && spread <= max_stretch_spread_log10) return;
-  param.summary["sphere_map_fallback"] =
-      flipped > 0 ? "hierarchical: the one-chart map flipped " + std::to_string(flipped) + " triangles"
-                  : "hierarchical: the one-chart map's area stretch spans " + std::to_string(static_cast<int>(spread)) +
-                        " orders of magnitude";
+  OneChartFailure failure;
+  failure.flipped = count_flipped(param.domain, mesh.F);
+  failure.stretch_spread_log10 = stretch_spread_log10(mesh, param.domain);
+  if (failure.flipped == 0 && !failure.squeezed()) return;
+  failure.reason = failure.flipped > 0
+                       ? "hierarchical: the one-chart map flipped " + std::to_string(failure.flipped) + " triangles"
+                       : "hierarchical: the one-chart map's area stretch spans " +
+                             std::to_string(static_cast<int>(failure.stretch_spread_log10)) + " orders of magnitude";
+  param.summary["sphere_map_fallback"] = failure.reason;
   param.sphere_map = SphereMap::hierarchical;
-  if (options.on_hierarchical_fallback) options.on_hierarchical_fallback();
+  if (options.on_hierarchical_fallback && !options.on_hierarchical_fallback(failure))
+    throw AlgorithmError("the one-chart sphere map failed (" + failure.reason +
+                         ") and the hierarchical map was declined");
   param.domain = hierarchical_sphere_map(mesh);
   param.cut.clear();
 }

@@ -44,14 +44,25 @@ enum class SphereMap {
   hierarchical
 };
 
+/// Why a one-chart sphere map failed (ParameterizationOptions::on_hierarchical_fallback).
+struct OneChartFailure {
+  int flipped = 0;                  ///< triangles it turned over
+  double stretch_spread_log10 = 0;  ///< orders of magnitude its area stretch spans (may be infinite)
+  std::string reason;               ///< the summary's `sphere_map_fallback`
+  /// The stretch spans more than 12 orders of magnitude: protrusions squeezed past what one
+  /// chart holds, whether or not a triangle flipped.
+  bool squeezed() const;
+};
+
 struct ParameterizationOptions {
   SphereMap sphere_map = SphereMap::automatic;
   /// With automatic: the face count from which the two-halves map is used (it solves faster on
   /// large inputs; docs/remesh.md, "Tuning knobs").
   int halves_from_faces = 100000;
   /// With automatic: called once, before the hierarchical map replaces a one-chart map that
-  /// failed (the automatic domain starts the base-mesh route then, on the other core).
-  std::function<void()> on_hierarchical_fallback;
+  /// failed (the automatic domain starts the base-mesh route then, on the other core). If it
+  /// returns false, parameterize() stops there and throws AlgorithmError.
+  std::function<bool(const OneChartFailure&)> on_hierarchical_fallback;
 };
 
 /// The input surface T embedded in D.

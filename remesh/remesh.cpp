@@ -40,6 +40,8 @@ namespace {
 
 using namespace remesh_stages;
 
+using HierarchicalFallbackFn = std::function<bool(const OneChartFailure&)>;
+
 void check_resolution_and_relaxation(const RemeshOptions& o, const std::string& at) {
   require_in(at + "levels", o.levels, 0, 12);
   if (o.levels == 0) require_at_least(at + "target_faces", o.target_faces, 16);
@@ -102,7 +104,7 @@ struct MappedInput {
 };
 
 MappedInput map_onto_domain(const PreparedInput& input, SphereMap sphere_map, bool needs_locator,
-                            const ProgressFn& progress, const std::function<void()>& on_hierarchical_fallback) {
+                            const ProgressFn& progress, const HierarchicalFallbackFn& on_hierarchical_fallback) {
   report(progress, "parameterize", 0);
   ParameterizationOptions param_options;
   param_options.sphere_map = sphere_map;
@@ -367,9 +369,9 @@ RemeshLevel build_level(const LevelContext& ctx, const RemeshOptions& options, i
 }
 
 // The sphere route: the input mapped onto the unit sphere or disk, the base in D, the levels.
-// `on_hierarchical_fallback` is called when the one-chart sphere map fails.
+// `on_hierarchical_fallback` is called when the one-chart sphere map fails (and may stop the route there).
 RemeshResult remesh_on_sphere(const TriMesh& input, const RemeshOptions& options,
-                              const std::function<void()>& on_hierarchical_fallback = {}) {
+                              const HierarchicalFallbackFn& on_hierarchical_fallback = {}) {
   RemeshResult result;
   const auto start = Clock::now();
   Resolution resolution = initial_resolution(options);
@@ -553,6 +555,24 @@ RemeshResult base_instead_of_sphere(BaseOutcome on_base, const std::exception_pt
   return with_domain_choice(std::move(*on_base.result), std::move(choice), "the sphere's route failed", start);
 }
 
+// The one-chart map squeezed the shape (`reason`), so the sphere route stopped there: the base
+// mesh's result, which holds protrusions; if it failed, the sphere route on the hierarchical
+// map after all, with the base mesh's failure recorded.
+RemeshResult base_alone_or_hierarchical_sphere(BaseOutcome on_base, const std::string& reason, const TriMesh& input,
+                                               const RemeshOptions& sphere_options, Clock::time_point start) {
+  nlohmann::json choice = {{"sphere_map_fallback", reason}};
+  if (on_base.result) {
+    choice["sphere"] = {{"skipped", "the one-chart map's squeeze: protrusions, which the base mesh holds"}};
+    choice["base_mesh"] = score_json(on_base.score);
+    return with_domain_choice(std::move(*on_base.result), std::move(choice),
+                              "the one-chart map squeezed the shape: the base mesh alone", start);
+  }
+  RemeshResult on_sphere = remesh_on_sphere(input, sphere_options);
+  choice["sphere"] = score_json(finest_level_score(on_sphere));
+  choice["base_mesh"] = {{"error", on_base.error}};
+  return with_domain_choice(std::move(on_sphere), std::move(choice), "the base mesh's route failed", start);
+}
+
 // Quality and distance to the input of every level, as build_level measures them.
 // \pre result.input_locator was kept (RemeshOptions::keep_input_locator).
 void measure_levels(const TriMesh& input, RemeshResult& result) {
@@ -604,17 +624,28 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   unmeasured.keep_input_locator = options.keep_input_locator || options.compute_stats;
   const auto progress_lock = std::make_shared<std::mutex>();
   BaseRouteBeside on_base(input, with_locked_progress(unmeasured, progress_lock, "base-mesh domain: "));
+  const RemeshOptions sphere_options = with_locked_progress(unmeasured, progress_lock, "");
+  std::string squeeze;  // why the sphere route stopped at its one-chart map, if it did
+  const auto on_fallback = [&](const OneChartFailure& failure) {
+    on_base.start();
+    // A squeeze means protrusions: on every such input measured, the base mesh's finest level
+    // was the better (docs/remesh.md, "The automatic domain"), so the hierarchical map is not
+    // built beside it.
+    if (options.base_mesh_alone_when_squeezed && failure.squeezed()) squeeze = failure.reason;
+    return squeeze.empty();
+  };
   std::optional<RemeshResult> on_sphere;
   std::exception_ptr sphere_failure;
   try {
-    on_sphere = remesh_on_sphere(input, with_locked_progress(unmeasured, progress_lock, ""), [&] { on_base.start(); });
+    on_sphere = remesh_on_sphere(input, sphere_options, on_fallback);
   } catch (const AlgorithmError&) {  // the base mesh may still hold the shape (built now, if not begun)
     sphere_failure = std::current_exception();
   }
-  RemeshResult kept = !on_sphere ? base_instead_of_sphere(on_base.outcome(), sphere_failure, start)
-                      : on_the_hierarchical_map(*on_sphere)
-                          ? better_of_both_domains(std::move(*on_sphere), on_base.outcome(), start)
-                          : std::move(*on_sphere);
+  RemeshResult kept =
+      !squeeze.empty() ? base_alone_or_hierarchical_sphere(on_base.outcome(), squeeze, input, sphere_options, start)
+      : !on_sphere     ? base_instead_of_sphere(on_base.outcome(), sphere_failure, start)
+      : on_the_hierarchical_map(*on_sphere) ? better_of_both_domains(std::move(*on_sphere), on_base.outcome(), start)
+                                            : std::move(*on_sphere);
   if (options.compute_stats) measure_levels(input, kept);
   return kept;
 }

@@ -152,6 +152,11 @@ struct RemeshOptions {
   ParameterDomain domain = ParameterDomain::automatic;
   /// How a closed genus-0 input is mapped onto the sphere (remesh/parameterization.h).
   SphereMap sphere_map = SphereMap::automatic;
+  /// With the automatic domain: where the one-chart sphere map squeezes the shape past 12
+  /// orders of magnitude of area stretch (OneChartFailure::squeezed), only the base-mesh domain
+  /// is built, and the hierarchical sphere map only if the base mesh fails; false builds both
+  /// and keeps the better, as where the one-chart map only flipped triangles.
+  bool base_mesh_alone_when_squeezed = true;
   SimplifyOptions simplify;
   SizingOptions sizing;
   BaseMeshOptions base;

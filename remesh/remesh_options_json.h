@@ -37,6 +37,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RepairOptions, sweeps, threshold
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SurfaceFitOptions, rounds, regularization, max_offset,
                                                 max_sample_distance, quality_floor)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RemeshOptions, levels, target_faces, base_vertices, relax, domain,
-                                                sphere_map, simplify, sizing, base, relaxation, snap, repair, fit)
+                                                sphere_map, base_mesh_alone_when_squeezed, simplify, sizing, base,
+                                                relaxation, snap, repair, fit)
 
 }  // namespace mrsnake

@@ -420,9 +420,11 @@ TEST(BaseDomainRemesh, WithSmoothRimOffTheRimVerticesStayWhereTheSplitPutThem) {
 // The automatic domain (the default): a capsule long enough that the one-chart sphere map
 // fails is built on both domains, the base mesh's on another thread, and the kept one is the
 // better by the rule it records; an ellipsoid, which one chart holds, stays on the sphere with
-// no second build.
+// no second build. (The capsule's one-chart map fails by its squeeze, which by default builds
+// the base mesh alone: the next test. Both are built by default where the map only flipped.)
 TEST(AutomaticDomain, AShapeOneChartCannotHoldKeepsTheBetterOfBothDomains) {
   RemeshOptions o;
+  o.base_mesh_alone_when_squeezed = false;
   o.target_faces = 4096;
   o.compute_stats = false;  // measured after the choice, out of the times checked below
   std::map<std::thread::id, std::vector<std::string>> stages_by_thread;
@@ -474,12 +476,53 @@ TEST(AutomaticDomain, AShapeOneChartCannotHoldKeepsTheBetterOfBothDomains) {
   EXPECT_FALSE(plain.parameterization.contains("domain_choice"));
 }
 
+// Squeezed by the one-chart map (protrusions), a capsule is built on the base mesh alone: the
+// sphere route stops at its one-chart map, and the result is the base-mesh domain's own. If the
+// base mesh fails, the sphere route is built on the hierarchical map after all.
+TEST(AutomaticDomain, AShapeTheOneChartMapSqueezesIsBuiltOnTheBaseMeshAlone) {
+  RemeshOptions o;
+  o.target_faces = 1024;
+  std::set<std::string> failing_stages;
+  std::vector<std::string> sphere_stages;  // the caller's: the sphere route's
+  o.progress = [&](const std::string& stage, double) {
+    if (failing_stages.count(stage)) throw AlgorithmError("no " + stage);
+    if (stage.rfind("base-mesh domain: ", 0) != 0) sphere_stages.push_back(stage);
+  };
+  const TriMesh capsule = test::capsule(40.0);
+  const RemeshResult r = remesh(capsule, o);
+  ASSERT_EQ(r.domain, "base_mesh");
+  const nlohmann::json& choice = r.parameterization["domain_choice"];
+  EXPECT_NE(choice["sphere_map_fallback"].get<std::string>().find("orders of magnitude"), std::string::npos) << choice;
+  EXPECT_TRUE(choice["sphere"].contains("skipped")) << choice;
+  EXPECT_EQ(choice["chosen"], "base_mesh");
+  EXPECT_EQ(choice["base_mesh"]["self_intersections"].get<int>(),
+            count_self_intersections(r.mesh(static_cast<int>(r.levels.size()) - 1)));
+  EXPECT_EQ(sphere_stages, std::vector<std::string>{"parameterize"});  // no level built on the sphere
+  // The levels are the base-mesh domain's, as built alone.
+  RemeshOptions alone = o;
+  alone.domain = ParameterDomain::base_mesh;
+  const RemeshResult on_base = remesh(capsule, alone);
+  ASSERT_EQ(on_base.levels.size(), r.levels.size());
+  for (std::size_t j = 0; j < r.levels.size(); ++j)
+    EXPECT_EQ(r.levels[j].positions, on_base.levels[j].positions) << "level " << j;
+  expect_valid_hierarchy(r, capsule);
+
+  failing_stages.insert("base-mesh domain: level 0");
+  const RemeshResult instead = remesh(capsule, o);
+  ASSERT_EQ(instead.domain, "sphere");
+  EXPECT_EQ(instead.parameterization["sphere_map"], "hierarchical");
+  EXPECT_EQ(instead.parameterization["domain_choice"]["base_mesh"]["error"], "no base-mesh domain: level 0");
+  EXPECT_EQ(instead.parameterization["domain_choice"]["chosen"], "sphere");
+  expect_valid_hierarchy(instead, capsule);
+}
+
 // Where the sphere route fails (here its progress callback throws at its first level), the base
-// mesh's result stands in: on a capsule it was built beside the hierarchical map, on an
-// ellipsoid (one chart holds it) it is built then. Either is measured as a kept domain is. Both
-// failing report the sphere's error.
+// mesh's result stands in: on a capsule it was built beside the hierarchical map (both domains
+// built, as where the one-chart map only flips), on an ellipsoid (one chart holds it) it is built
+// then. Either is measured as a kept domain is. Both failing report the sphere's error.
 TEST(AutomaticDomain, TheBaseMeshStandsInWhereTheSphereRouteFails) {
   RemeshOptions o;
+  o.base_mesh_alone_when_squeezed = false;
   o.target_faces = 1024;
   std::set<std::string> failing_stages = {"level 0"};
   o.progress = [&](const std::string& stage, double) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "mesh/errors.h"
@@ -88,19 +89,39 @@ TEST(HierarchicalMap, OfASphereIsNearlyASimilarity) {
   EXPECT_LT(area_stretch_spread_log10(sphere, D), 0.5);
 }
 
+// A squeeze is a stretch past 12 orders of magnitude, flips or not; flips alone are none.
+TEST(HierarchicalMap, AOneChartMapIsSqueezedPastTwelveOrdersOfMagnitude) {
+  const auto failure = [](int flipped, double spread) { return OneChartFailure{flipped, spread, ""}; };
+  EXPECT_FALSE(failure(1, 4.7).squeezed());
+  EXPECT_FALSE(failure(0, 12.0).squeezed());
+  EXPECT_TRUE(failure(0, 12.5).squeezed());
+  EXPECT_TRUE(failure(1955, std::numeric_limits<double>::infinity()).squeezed());
+  EXPECT_TRUE(failure(3, std::numeric_limits<double>::quiet_NaN()).squeezed());  // not measurable
+}
+
 TEST(HierarchicalMap, TheAutomaticSphereMapFallsBackToItAndEveryLevelIsFlipFree) {
   const TriMesh tube = test::capsule(30.0);
   ParameterizationOptions told;
   int fallbacks = 0;
-  told.on_hierarchical_fallback = [&] { ++fallbacks; };
+  OneChartFailure failure;
+  told.on_hierarchical_fallback = [&](const OneChartFailure& f) {
+    ++fallbacks;
+    failure = f;
+    return true;
+  };
   const Parameterization param = parameterize(tube, told);
   EXPECT_EQ(fallbacks, 1);  // the automatic domain starts the base-mesh route on it
+  EXPECT_TRUE(failure.squeezed()) << failure.stretch_spread_log10;  // a tube 30 radii long
+  EXPECT_EQ(param.summary.value("sphere_map_fallback", std::string()), failure.reason);
   EXPECT_EQ(parameterize(icosphere(3), told).sphere_map, SphereMap::punctured);
   EXPECT_EQ(fallbacks, 1);  // no fallback, no call
   EXPECT_EQ(param.sphere_map, SphereMap::hierarchical);
   EXPECT_EQ(param.summary["sphere_map"], "hierarchical");
   EXPECT_NE(param.summary.value("sphere_map_fallback", std::string()).find("hierarchical: the one-chart map"),
             std::string::npos);
+  // Declined, the hierarchical map is not built: the parameterization stops there.
+  told.on_hierarchical_fallback = [](const OneChartFailure&) { return false; };
+  EXPECT_THROW(parameterize(tube, told), AlgorithmError);
 
   RemeshOptions options;
   options.domain = ParameterDomain::sphere;  // the sphere route alone (the default also tries the base mesh)
