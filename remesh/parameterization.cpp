@@ -493,6 +493,17 @@ Eigen::Vector3d mobius_to_center(const Eigen::Vector3d& a, const Eigen::Vector3d
 
 bool OneChartFailure::squeezed() const { return !(stretch_spread_log10 <= max_stretch_spread_log10); }
 
+std::string OneChartFailure::reason() const {
+  const std::string flips = "flipped " + std::to_string(flipped) + " triangles";
+  const std::string squeeze =
+      std::isfinite(stretch_spread_log10)
+          ? "area stretch spans " + std::to_string(static_cast<int>(stretch_spread_log10)) + " orders of magnitude"
+          : "area stretch spans more orders of magnitude than doubles measure";
+  if (!squeezed()) return "the one-chart map " + flips;
+  if (flipped == 0) return "the one-chart map's " + squeeze;
+  return "the one-chart map " + flips + ", and its " + squeeze;
+}
+
 namespace {
 
 // A one-chart map that flipped triangles or squeezed a protrusion past what doubles resolve is
@@ -505,15 +516,10 @@ void fall_back_to_hierarchical_map(const TriMesh& mesh, const ParameterizationOp
   failure.flipped = count_flipped(param.domain, mesh.F);
   failure.stretch_spread_log10 = stretch_spread_log10(mesh, param.domain);
   if (failure.flipped == 0 && !failure.squeezed()) return;
-  failure.reason = failure.flipped > 0
-                       ? "hierarchical: the one-chart map flipped " + std::to_string(failure.flipped) + " triangles"
-                       : "hierarchical: the one-chart map's area stretch spans " +
-                             std::to_string(static_cast<int>(failure.stretch_spread_log10)) + " orders of magnitude";
-  param.summary["sphere_map_fallback"] = failure.reason;
+  param.summary["sphere_map_fallback"] = "hierarchical: " + failure.reason();
   param.sphere_map = SphereMap::hierarchical;
   if (options.on_hierarchical_fallback && !options.on_hierarchical_fallback(failure))
-    throw AlgorithmError("the one-chart sphere map failed (" + failure.reason +
-                         ") and the hierarchical map was declined");
+    throw AlgorithmError(failure.reason() + "; the hierarchical map was declined");
   param.domain = hierarchical_sphere_map(mesh);
   param.cut.clear();
 }

@@ -15,6 +15,7 @@
 /// Either is then balanced by Möbius transformations until the area-weighted centroid sits at
 /// the centre. No seam in D.
 #include <functional>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -48,11 +49,16 @@ enum class SphereMap {
 struct OneChartFailure {
   int flipped = 0;                  ///< triangles it turned over
   double stretch_spread_log10 = 0;  ///< orders of magnitude its area stretch spans (may be infinite)
-  std::string reason;               ///< the summary's `sphere_map_fallback`
   /// The stretch spans more than 12 orders of magnitude: protrusions squeezed past what one
   /// chart holds, whether or not a triangle flipped.
   bool squeezed() const;
+  /// What failed, in words: the flips, the squeeze, or both (the summary's
+  /// `sphere_map_fallback`, after "hierarchical: ").
+  std::string reason() const;
 };
+
+/// Called when a one-chart sphere map failed; returns whether the hierarchical map replaces it.
+using HierarchicalFallbackFn = std::function<bool(const OneChartFailure&)>;
 
 struct ParameterizationOptions {
   SphereMap sphere_map = SphereMap::automatic;
@@ -62,7 +68,7 @@ struct ParameterizationOptions {
   /// With automatic: called once, before the hierarchical map replaces a one-chart map that
   /// failed (the automatic domain starts the base-mesh route then, on the other core). If it
   /// returns false, parameterize() stops there and throws AlgorithmError.
-  std::function<bool(const OneChartFailure&)> on_hierarchical_fallback;
+  HierarchicalFallbackFn on_hierarchical_fallback;
 };
 
 /// The input surface T embedded in D.

@@ -40,8 +40,6 @@ namespace {
 
 using namespace remesh_stages;
 
-using HierarchicalFallbackFn = std::function<bool(const OneChartFailure&)>;
-
 void check_resolution_and_relaxation(const RemeshOptions& o, const std::string& at) {
   require_in(at + "levels", o.levels, 0, 12);
   if (o.levels == 0) require_at_least(at + "target_faces", o.target_faces, 16);
@@ -557,9 +555,10 @@ RemeshResult base_instead_of_sphere(BaseOutcome on_base, const std::exception_pt
 
 // The one-chart map squeezed the shape (`reason`), so the sphere route stopped there: the base
 // mesh's result, which holds protrusions; if it failed, the sphere route on the hierarchical
-// map after all, with the base mesh's failure recorded.
+// map after all (straight away: the one-chart map is known to fail), with the base mesh's
+// failure recorded.
 RemeshResult base_alone_or_hierarchical_sphere(BaseOutcome on_base, const std::string& reason, const TriMesh& input,
-                                               const RemeshOptions& sphere_options, Clock::time_point start) {
+                                               RemeshOptions sphere_options, Clock::time_point start) {
   nlohmann::json choice = {{"sphere_map_fallback", reason}};
   if (on_base.result) {
     choice["sphere"] = {{"skipped", "the one-chart map's squeeze: protrusions, which the base mesh holds"}};
@@ -567,6 +566,7 @@ RemeshResult base_alone_or_hierarchical_sphere(BaseOutcome on_base, const std::s
     return with_domain_choice(std::move(*on_base.result), std::move(choice),
                               "the one-chart map squeezed the shape: the base mesh alone", start);
   }
+  sphere_options.sphere_map = SphereMap::hierarchical;
   RemeshResult on_sphere = remesh_on_sphere(input, sphere_options);
   choice["sphere"] = score_json(finest_level_score(on_sphere));
   choice["base_mesh"] = {{"error", on_base.error}};
@@ -625,14 +625,14 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   const auto progress_lock = std::make_shared<std::mutex>();
   BaseRouteBeside on_base(input, with_locked_progress(unmeasured, progress_lock, "base-mesh domain: "));
   const RemeshOptions sphere_options = with_locked_progress(unmeasured, progress_lock, "");
-  std::string squeeze;  // why the sphere route stopped at its one-chart map, if it did
+  std::optional<std::string> squeeze;  // why the sphere route stopped at its one-chart map, if it did
   const auto on_fallback = [&](const OneChartFailure& failure) {
     on_base.start();
     // A squeeze means protrusions: on every such input measured, the base mesh's finest level
     // was the better (docs/remesh.md, "The automatic domain"), so the hierarchical map is not
     // built beside it.
-    if (options.base_mesh_alone_when_squeezed && failure.squeezed()) squeeze = failure.reason;
-    return squeeze.empty();
+    if (options.base_mesh_alone_when_squeezed && failure.squeezed()) squeeze = failure.reason();
+    return !squeeze;
   };
   std::optional<RemeshResult> on_sphere;
   std::exception_ptr sphere_failure;
@@ -641,11 +641,15 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   } catch (const AlgorithmError&) {  // the base mesh may still hold the shape (built now, if not begun)
     sphere_failure = std::current_exception();
   }
-  RemeshResult kept =
-      !squeeze.empty() ? base_alone_or_hierarchical_sphere(on_base.outcome(), squeeze, input, sphere_options, start)
-      : !on_sphere     ? base_instead_of_sphere(on_base.outcome(), sphere_failure, start)
-      : on_the_hierarchical_map(*on_sphere) ? better_of_both_domains(std::move(*on_sphere), on_base.outcome(), start)
-                                            : std::move(*on_sphere);
+  RemeshResult kept;
+  if (squeeze)
+    kept = base_alone_or_hierarchical_sphere(on_base.outcome(), *squeeze, input, sphere_options, start);
+  else if (!on_sphere)
+    kept = base_instead_of_sphere(on_base.outcome(), sphere_failure, start);
+  else if (on_the_hierarchical_map(*on_sphere))
+    kept = better_of_both_domains(std::move(*on_sphere), on_base.outcome(), start);
+  else
+    kept = std::move(*on_sphere);
   if (options.compute_stats) measure_levels(input, kept);
   return kept;
 }

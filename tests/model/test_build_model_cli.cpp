@@ -337,12 +337,12 @@ std::string write_tube_labels(const std::filesystem::path& dir, int length, doub
 
 }  // namespace
 
-TEST(BuildModelCli, LongTubesArePuncturedInTheMiddleAndTheTooLongMappedHierarchically) {
+TEST(BuildModelCli, LongTubesArePuncturedInTheMiddleAndTheTooLongBuiltOnTheBaseMesh) {
   // A one-chart sphere map squeezes a tube's far end exponentially in its length over its
   // radius. Punctured near the middle, a 70-voxel tube of radius 2.5 stays within the limit
-  // (12 orders of magnitude) and keeps the conformal map. A 100-voxel one does not: the
-  // hierarchical map stands in, the base-mesh domain is built too, and the better of the two
-  // is kept, with no flipped triangle at any level.
+  // (12 orders of magnitude) and keeps the conformal map. A 100-voxel one does not: squeezed,
+  // it is built on the base-mesh domain alone (the hierarchical sphere map only if that
+  // failed), with no flipped triangle at any level.
   const auto dir = scratch_dir("build-model-cli-tube");
   const std::string model = (dir / "tube.model").string();
   const auto built =
@@ -364,6 +364,8 @@ TEST(BuildModelCli, LongTubesArePuncturedInTheMiddleAndTheTooLongMappedHierarchi
   EXPECT_NE(choice.value("sphere_map_fallback", std::string()).find("orders of magnitude"), std::string::npos)
       << choice;
   EXPECT_TRUE(choice["base_mesh"].contains("q_mean")) << choice;
+  EXPECT_TRUE(choice["sphere"].contains("skipped")) << choice;  // squeezed: the base mesh alone
+  EXPECT_EQ(choice["chosen"], "base_mesh");
   EXPECT_EQ(long_tube.remesh_quality["domain"], choice["chosen"]);
   for (const auto& level : long_tube.remesh_quality["per_level"]) EXPECT_EQ(level["flipped_triangles"], 0) << level;
   std::filesystem::remove_all(dir);

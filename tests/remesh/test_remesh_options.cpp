@@ -55,6 +55,7 @@ TEST(RemeshOptionsJson, GivenKeysReplaceDefaultsAndRoundTrip) {
   const nlohmann::json given = {{"levels", 2},
                                 {"relax", "new_vertices_only"},
                                 {"sphere_map", "two_halves"},
+                                {"base_mesh_alone_when_squeezed", false},
                                 {"sizing", {{"curvature_weight", 0.7}}},
                                 {"repair", {{"threshold", 0.8}, {"coarse_levels", false}}},
                                 {"fit", {{"rounds", 2}}}};
@@ -62,6 +63,8 @@ TEST(RemeshOptionsJson, GivenKeysReplaceDefaultsAndRoundTrip) {
   EXPECT_EQ(o.levels, 2);
   EXPECT_EQ(o.relax, RelaxMode::new_vertices_only);
   EXPECT_EQ(o.sphere_map, SphereMap::two_halves);
+  EXPECT_TRUE(RemeshOptions{}.base_mesh_alone_when_squeezed);
+  EXPECT_FALSE(o.base_mesh_alone_when_squeezed);
   EXPECT_EQ(o.sizing.curvature_weight, 0.7);
   EXPECT_EQ(o.sizing.curvature_exponent, RemeshOptions{}.sizing.curvature_exponent);
   EXPECT_EQ(o.repair.threshold, 0.8);

@@ -91,12 +91,25 @@ TEST(HierarchicalMap, OfASphereIsNearlyASimilarity) {
 
 // A squeeze is a stretch past 12 orders of magnitude, flips or not; flips alone are none.
 TEST(HierarchicalMap, AOneChartMapIsSqueezedPastTwelveOrdersOfMagnitude) {
-  const auto failure = [](int flipped, double spread) { return OneChartFailure{flipped, spread, ""}; };
+  const auto failure = [](int flipped, double spread) { return OneChartFailure{flipped, spread}; };
   EXPECT_FALSE(failure(1, 4.7).squeezed());
   EXPECT_FALSE(failure(0, 12.0).squeezed());
   EXPECT_TRUE(failure(0, 12.5).squeezed());
   EXPECT_TRUE(failure(1955, std::numeric_limits<double>::infinity()).squeezed());
   EXPECT_TRUE(failure(3, std::numeric_limits<double>::quiet_NaN()).squeezed());  // not measurable
+}
+
+// The reason names what failed: the flips, the squeeze (past what doubles measure, if so), or
+// both. A squeezed octopus-like shape flips too, and the report must not name only the flips.
+TEST(HierarchicalMap, AFailedOneChartMapSaysWhetherItFlippedOrWasSqueezedOrBoth) {
+  const double infinite = std::numeric_limits<double>::infinity();
+  EXPECT_EQ((OneChartFailure{1, 4.7}.reason()), "the one-chart map flipped 1 triangles");
+  EXPECT_EQ((OneChartFailure{0, 17.1}.reason()), "the one-chart map's area stretch spans 17 orders of magnitude");
+  EXPECT_EQ((OneChartFailure{0, infinite}.reason()),
+            "the one-chart map's area stretch spans more orders of magnitude than doubles measure");
+  EXPECT_EQ((OneChartFailure{1955, infinite}.reason()),
+            "the one-chart map flipped 1955 triangles, and its area stretch spans more orders of magnitude than "
+            "doubles measure");
 }
 
 TEST(HierarchicalMap, TheAutomaticSphereMapFallsBackToItAndEveryLevelIsFlipFree) {
@@ -112,7 +125,7 @@ TEST(HierarchicalMap, TheAutomaticSphereMapFallsBackToItAndEveryLevelIsFlipFree)
   const Parameterization param = parameterize(tube, told);
   EXPECT_EQ(fallbacks, 1);  // the automatic domain starts the base-mesh route on it
   EXPECT_TRUE(failure.squeezed()) << failure.stretch_spread_log10;  // a tube 30 radii long
-  EXPECT_EQ(param.summary.value("sphere_map_fallback", std::string()), failure.reason);
+  EXPECT_EQ(param.summary.value("sphere_map_fallback", std::string()), "hierarchical: " + failure.reason());
   EXPECT_EQ(parameterize(icosphere(3), told).sphere_map, SphereMap::punctured);
   EXPECT_EQ(fallbacks, 1);  // no fallback, no call
   EXPECT_EQ(param.sphere_map, SphereMap::hierarchical);

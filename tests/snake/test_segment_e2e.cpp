@@ -401,9 +401,8 @@ TEST(SegmentReal, LiverOfTheAbdomenCtReachesDice09WithoutSelfIntersections) {
 
 TEST(SegmentReal, TheLateralVentriclesWithTheirHornsBuildAModelAndSegment) {
   // The lateral ventricles (label 1 of the MRI crop, its larger part) have long horns: their
-  // one-chart sphere map squeezes past 12 orders of magnitude. The hierarchical map stands in
-  // and the base-mesh domain is built too; the model builds with every default and segments
-  // a new case.
+  // one-chart sphere map squeezes past 12 orders of magnitude, so the model is built on the
+  // base-mesh domain alone; it builds with every default and segments a new case.
   MRSNAKE_REQUIRE_DATA(image, "volumes/MRIcrop-orig.gipl.gz");
   MRSNAKE_REQUIRE_DATA(labels, "volumes/MRIcrop-seg.gipl.gz");
   const auto dir = mrsnake::test::scratch_dir("segment-real-ventricles");
