@@ -8,8 +8,8 @@ Hausdorff <= 0.5 % of the diagonal, faster than CGAL), the speed ratios, the sum
 that the Markdown page shows the same verdicts. It also reads report.json through the benchmark,
 so a renamed key of mrsnake's report breaks it here, not in the next benchmark run.
 
-  bench_remesh_smoke.py   (BENCH_REMESH_BIN names the bench_remesh executable)
-No data folder is needed: the input is written here.
+  bench_remesh_smoke.py   (BENCH_REMESH_BIN and MRSNAKE_BIN name the executables)
+No data folder is needed: the input is mrsnake synth's.
 """
 import json
 import math
@@ -19,48 +19,17 @@ import sys
 import tempfile
 
 BENCH = os.environ["BENCH_REMESH_BIN"]
+MRSNAKE = os.environ["MRSNAKE_BIN"]
 TARGET = 2048
 METHODS = {"mrsnake", "mrsnake-norelax", "cgal-isotropic"}
 
 
-def icosphere(levels):
-    """The unit icosphere: the icosahedron split 1:4 `levels` times, its vertices on the sphere."""
-    t = (1 + 5**0.5) / 2
-    vertices = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t),
-                (0, -1, -t), (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
-    faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4),
-             (11, 10, 2), (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8),
-             (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
-    vertices = [tuple(c / math.sqrt(sum(x * x for x in v)) for c in v) for v in vertices]
-    for _ in range(levels):
-        midpoint = {}
-
-        def middle(a, b):
-            key = (min(a, b), max(a, b))
-            if key not in midpoint:
-                m = [(p + q) / 2 for p, q in zip(vertices[a], vertices[b])]
-                n = math.sqrt(sum(x * x for x in m))
-                vertices.append(tuple(x / n for x in m))
-                midpoint[key] = len(vertices) - 1
-            return midpoint[key]
-
-        split = []
-        for a, b, c in faces:
-            ab, bc, ca = middle(a, b), middle(b, c), middle(c, a)
-            split += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
-        faces = split
-    return vertices, faces
-
-
-def write_ellipsoid(path):
-    """An ellipsoid with semi-axes 3, 1.5 and 1 (1280 faces): uneven stretch, one chart holds it."""
-    vertices, faces = icosphere(3)
-    with open(path, "w") as f:
-        f.write(f"OFF\n{len(vertices)} {len(faces)} 0\n")
-        for x, y, z in vertices:
-            f.write(f"{3 * x:.9f} {1.5 * y:.9f} {z:.9f}\n")
-        for a, b, c in faces:
-            f.write(f"3 {a} {b} {c}\n")
+def write_ellipsoid(folder):
+    """mrsnake synth's ellipsoid surface (a closed genus-0 surface of 2412 faces): uneven
+    stretch, and one chart holds it. Returns its path."""
+    subprocess.run([MRSNAKE, "-q", "synth", "--shape", "ellipsoid", "--size", "32", "--noise", "none", "-o", folder],
+                   check=True)
+    return os.path.join(folder, "truth.vtp")
 
 
 def expected_missed(row, cgal):
@@ -119,8 +88,7 @@ def check_page(page, by_method, summary):
 
 def main():
     with tempfile.TemporaryDirectory() as tmp:
-        mesh = os.path.join(tmp, "ellipsoid.off")
-        write_ellipsoid(mesh)
+        mesh = write_ellipsoid(os.path.join(tmp, "synth"))
         out, page = os.path.join(tmp, "out"), os.path.join(tmp, "page.md")
         run = subprocess.run([BENCH, "--inputs", mesh, "--targets", str(TARGET), "--repeat", "1", "--samples", "4",
                               "--out", out, "--markdown", page], capture_output=True, text=True)
