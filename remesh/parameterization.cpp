@@ -516,10 +516,10 @@ void fall_back_to_hierarchical_map(const TriMesh& mesh, const ParameterizationOp
   failure.flipped = count_flipped(param.domain, mesh.F);
   failure.stretch_spread_log10 = stretch_spread_log10(mesh, param.domain);
   if (failure.flipped == 0 && !failure.squeezed()) return;
-  param.summary["sphere_map_fallback"] = "hierarchical: " + failure.reason();
-  param.sphere_map = SphereMap::hierarchical;
   if (options.on_hierarchical_fallback && !options.on_hierarchical_fallback(failure))
     throw AlgorithmError(failure.reason() + "; the hierarchical map was declined");
+  param.summary["sphere_map_fallback"] = "hierarchical: " + failure.reason();
+  param.sphere_map = SphereMap::hierarchical;
   param.domain = hierarchical_sphere_map(mesh);
   param.cut.clear();
 }
