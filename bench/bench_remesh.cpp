@@ -698,6 +698,12 @@ std::optional<double> internal_seconds(const json& report) {
   return total;
 }
 
+/// Whether a level of `faces` faces is nearer `target` than the nearest so far (`nearest` < 0:
+/// none yet). Levels come coarse to fine, so a tie keeps the coarser one.
+bool nearer_target(int faces, int nearest, int target) {
+  return nearest < 0 || std::abs(faces - target) < std::abs(nearest - target);
+}
+
 /// The face count of report.json's level nearest `target` (the level the row measures), or
 /// `target` if the report has no levels.
 int nearest_level_faces(const json& report, int target) {
@@ -705,7 +711,7 @@ int nearest_level_faces(const json& report, int target) {
   if (report.contains("per_level") && report["per_level"].is_array())
     for (const auto& level : report["per_level"]) {
       const int faces = level.value("faces", -1);
-      if (faces > 0 && (nearest < 0 || std::abs(faces - target) < std::abs(nearest - target))) nearest = faces;
+      if (faces > 0 && nearer_target(faces, nearest, target)) nearest = faces;
     }
   return nearest > 0 ? nearest : target;
 }
@@ -778,7 +784,7 @@ Row run_mrsnake_remesh(const Options& o, const std::string& name, const std::str
     const fs::path file = dir / ("level_" + std::to_string(level) + ".vtp");
     if (!fs::exists(file)) break;
     TriMesh m = read_mesh(file.string());
-    if (best_faces < 0 || std::abs(m.num_faces() - target) < std::abs(best_faces - target)) {
+    if (nearer_target(m.num_faces(), best_faces, target)) {
       best_faces = m.num_faces();
       best = std::move(m);
       row.level = level;
