@@ -2,7 +2,7 @@
 /// \file parameterization.h
 /// Maps a disk or closed genus-0 surface onto the domain D and measures its area distortion.
 ///
-/// Disk: CGAL mean value coordinates with the boundary on the unit circle by arc length
+/// Disk: mean value coordinates (Floater) with the boundary on a circle by arc length
 /// (Floater's theorem: no flipped triangle). Closed genus 0, either
 /// - punctured: the star of one well-shaped vertex is removed, the rest is mapped to the unit
 ///   disk the same way (a discrete approximation of the conformal map of the punctured
@@ -88,10 +88,13 @@ struct Parameterization {
 /// \throw AlgorithmError if the solver fails, a triangle flips, or the distortion is extreme.
 Parameterization parameterize(const TriMesh& input, const ParameterizationOptions& options = {});
 
-/// CGAL mean value coordinates of a disk, boundary fixed on the unit circle by arc length.
-/// Returns one (u, v) row per vertex.
+/// Mean value coordinates of a disk (Floater 2003), the boundary fixed by arc length on the
+/// circle of centre (0.5, 0.5) and radius 0.5: the map of CGAL's
+/// Mean_value_coordinates_parameterizer_3 with its default border, assembled from the triangle
+/// list and factored once with KLU. Returns one (u, v) row per vertex.
 /// \pre disk is a topological disk without unreferenced vertices.
-/// \throw AlgorithmError if CGAL reports a failure or returns non-finite coordinates.
+/// \throw AlgorithmError if the rim is not one loop, the system cannot be solved, or the
+/// coordinates are not finite.
 Eigen::MatrixX2d mean_value_disk_map(const TriMesh& disk);
 
 namespace detail {

@@ -1,7 +1,16 @@
-// The mean value parameterization (remesh/cgal_mean_value.cpp, remesh/parameterization.cpp):
-// whatever the ordering and factorization, the disk map must solve Floater's mean value system;
-// the two-halves sphere map must glue its halves into an embedding with a clean cut.
+// The mean value parameterization (remesh/mean_value.cpp, remesh/parameterization.cpp):
+// whatever the ordering and factorization, the disk map must solve Floater's mean value system
+// and equal CGAL's mean value parameterizer; the two-halves sphere map must glue its halves into
+// an embedding with a clean cut.
 #include <gtest/gtest.h>
+
+#include <CGAL/Eigen_solver_traits.h>
+#include <CGAL/Polygon_mesh_processing/measure.h>
+#include <CGAL/Simple_cartesian.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/Surface_mesh_parameterization/Circular_border_parameterizer_3.h>
+#include <CGAL/Surface_mesh_parameterization/Mean_value_coordinates_parameterizer_3.h>
+#include <CGAL/Surface_mesh_parameterization/parameterize.h>
 
 #include <Eigen/SVD>
 #include <Eigen/SparseLU>
@@ -9,6 +18,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numeric>
 #include <random>
 #include <utility>
 #include <vector>
@@ -38,7 +48,46 @@ Eigen::SparseMatrix<double> mean_value_weights(const TriMesh& m) {
   return W;
 }
 
+// CGAL's mean value parameterizer with its default arc-length circular border, solved by
+// Eigen's SparseLU: the map mean_value_disk_map reproduces.
+Eigen::MatrixX2d cgal_mean_value_map(const TriMesh& disk) {
+  using Kernel = CGAL::Simple_cartesian<double>;
+  using SurfaceMesh = CGAL::Surface_mesh<Kernel::Point_3>;
+  namespace SMP = CGAL::Surface_mesh_parameterization;
+  using Solver = CGAL::Eigen_solver_traits<Eigen::SparseLU<CGAL::Eigen_sparse_matrix<double>::EigenType>>;
+  using Parameterizer =
+      SMP::Mean_value_coordinates_parameterizer_3<SurfaceMesh,
+                                                  SMP::Circular_border_arc_length_parameterizer_3<SurfaceMesh>, Solver>;
+  SurfaceMesh sm;
+  std::vector<SurfaceMesh::Vertex_index> vertex;
+  for (int v = 0; v < disk.num_vertices(); ++v)
+    vertex.push_back(sm.add_vertex(Kernel::Point_3(disk.V(v, 0), disk.V(v, 1), disk.V(v, 2))));
+  for (int f = 0; f < disk.num_faces(); ++f)
+    sm.add_face(vertex[disk.F(f, 0)], vertex[disk.F(f, 1)], vertex[disk.F(f, 2)]);
+  auto uv = sm.add_property_map<SurfaceMesh::Vertex_index, Kernel::Point_2>("v:uv").first;
+  const auto border = CGAL::Polygon_mesh_processing::longest_border(sm).first;
+  EXPECT_EQ(SMP::parameterize(sm, Parameterizer(), border, uv), SMP::OK);
+  Eigen::MatrixX2d out(disk.num_vertices(), 2);
+  for (int v = 0; v < disk.num_vertices(); ++v) out.row(v) << uv[vertex[v]].x(), uv[vertex[v]].y();
+  return out;
+}
+
 }  // namespace
+
+TEST(MeanValueMap, EqualsCGALsMeanValueParameterizerWhateverTheFaceOrder) {
+  TriMesh disk = test::spherical_cap(4);
+  for (const int seed : {0, 1, 2}) {
+    if (seed > 0) {  // the rim's first vertex and direction follow the face order, as in CGAL
+      std::vector<int> order(disk.num_faces());
+      std::iota(order.begin(), order.end(), 0);
+      std::shuffle(order.begin(), order.end(), std::mt19937(seed));
+      const RowMatrixX3i F = disk.F;
+      for (int f = 0; f < disk.num_faces(); ++f) disk.F.row(f) = F.row(order[f]);
+    }
+    const Eigen::MatrixX2d uv = mean_value_disk_map(disk);
+    EXPECT_LT((uv - cgal_mean_value_map(disk)).cwiseAbs().maxCoeff(), 1e-9) << "face order " << seed;
+  }
+}
 
 TEST(MeanValueMap, SolvesTheMeanValueSystemAsAPlainSparseLUDoesWithoutFlips) {
   const TriMesh disk = test::spherical_cap(5);
