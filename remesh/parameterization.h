@@ -83,8 +83,8 @@ struct Parameterization {
   nlohmann::json summary;  ///< method, distortion range, seconds
 };
 
-/// \pre input is a disk or a closed genus-0 surface.
-/// \throw TopologyError if it is neither.
+/// \pre input is a disk or a closed genus-0 surface, its faces consistently oriented.
+/// \throw TopologyError if it is neither, or its faces are not consistently oriented.
 /// \throw AlgorithmError if the solver fails, a triangle flips, or the distortion is extreme.
 Parameterization parameterize(const TriMesh& input, const ParameterizationOptions& options = {});
 

@@ -23,6 +23,7 @@
 #include <utility>
 #include <vector>
 
+#include "mesh/errors.h"
 #include "mesh/topology.h"
 #include "remesh/parameterization.h"
 #include "tests/remesh/remesh_shapes.h"
@@ -63,7 +64,8 @@ Eigen::MatrixX2d cgal_mean_value_map(const TriMesh& disk) {
   for (int v = 0; v < disk.num_vertices(); ++v)
     vertex.push_back(sm.add_vertex(Kernel::Point_3(disk.V(v, 0), disk.V(v, 1), disk.V(v, 2))));
   for (int f = 0; f < disk.num_faces(); ++f)
-    sm.add_face(vertex[disk.F(f, 0)], vertex[disk.F(f, 1)], vertex[disk.F(f, 2)]);
+    EXPECT_NE(sm.add_face(vertex[disk.F(f, 0)], vertex[disk.F(f, 1)], vertex[disk.F(f, 2)]), SurfaceMesh::null_face())
+        << "face " << f;
   auto uv = sm.add_property_map<SurfaceMesh::Vertex_index, Kernel::Point_2>("v:uv").first;
   const auto border = CGAL::Polygon_mesh_processing::longest_border(sm).first;
   EXPECT_EQ(SMP::parameterize(sm, Parameterizer(), border, uv), SMP::OK);
@@ -87,6 +89,32 @@ TEST(MeanValueMap, EqualsCGALsMeanValueParameterizerWhateverTheFaceOrder) {
     const Eigen::MatrixX2d uv = mean_value_disk_map(disk);
     EXPECT_LT((uv - cgal_mean_value_map(disk)).cwiseAbs().maxCoeff(), 1e-9) << "face order " << seed;
   }
+}
+
+// Degenerate corners follow CGAL's tangent weight too: an angle of π gives a tangent of about
+// 1.6e16, and an edge of zero length a weight of 0 (its corners' angles are then taken as π/2).
+TEST(MeanValueMap, EqualsCGALsMeanValueParameterizerWithDegenerateCorners) {
+  const int v = 2 * 7 + 2, right = v + 1, up_right = v + 8;  // vertex (2, 2) of a 6 x 6 grid, face (v, right, up_right)
+  TriMesh straight = test::flat_grid(6);
+  straight.V.row(v) = 0.5 * (straight.V.row(right) + straight.V.row(up_right));  // the corner at v is π
+  EXPECT_LT((mean_value_disk_map(straight) - cgal_mean_value_map(straight)).cwiseAbs().maxCoeff(), 1e-9);
+  TriMesh collapsed = test::flat_grid(6);
+  collapsed.V.row(v) = collapsed.V.row(right);  // the edge v -> right has zero length
+  EXPECT_LT((mean_value_disk_map(collapsed) - cgal_mean_value_map(collapsed)).cwiseAbs().maxCoeff(), 1e-9);
+}
+
+TEST(MeanValueMap, RefusesARimOfTwoLoops) {
+  const TriMesh grid = test::flat_grid(6);
+  std::vector<int> kept;  // all but the two faces of cell (2, 2), an inner hole
+  for (int f = 0; f < grid.num_faces(); ++f)
+    if (f / 2 != 2 * 6 + 2) kept.push_back(f);
+  EXPECT_THROW(mean_value_disk_map(extract_faces(grid, kept)), AlgorithmError);
+}
+
+TEST(Parameterize, RefusesFacesOrientedInconsistently) {
+  TriMesh disk = test::flat_grid(6);
+  std::swap(disk.F(30, 1), disk.F(30, 2));
+  EXPECT_THROW(parameterize(disk), TopologyError);
 }
 
 TEST(MeanValueMap, SolvesTheMeanValueSystemAsAPlainSparseLUDoesWithoutFlips) {
