@@ -3,8 +3,9 @@
 // assembled straight from the triangle list and factored once with SuiteSparse's KLU.
 //
 // Why not CGAL's parameterizer itself: on the 31k-vertex mask, building its Surface_mesh and
-// running it around the same KLU factorization took 0.07 s more (the map: 0.40 s, now 0.33 s,
-// medians of 7 runs); tests/remesh/test_parameterization.cpp checks this map against it.
+// running it around the same KLU factorization took 0.07 s more (the parameterization: 0.40 s,
+// now 0.33 s, medians of 7 runs). tests/remesh/test_parameterization.cpp checks this map
+// against it.
 #include <Eigen/KLUSupport>
 #include <Eigen/Sparse>
 
