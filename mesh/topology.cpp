@@ -249,6 +249,9 @@ TriMesh remove_unreferenced_vertices(const TriMesh& mesh) {
 }
 
 void require_disk_or_sphere(const TopologyReport& r, const std::string& what) {
+  if ((r.is_disk() || r.is_closed_genus0()) && r.inconsistently_oriented_edges > 0)
+    throw TopologyError(what + " has " + std::to_string(r.inconsistently_oriented_edges) +
+                        " inconsistently oriented edges; orient its faces consistently first");
   if (r.is_disk() || r.is_closed_genus0()) return;
   std::string advice;
   if (r.faces == 0)

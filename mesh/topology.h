@@ -49,8 +49,8 @@ TriMesh extract_faces(const TriMesh& mesh, const std::vector<int>& faces);
 /// Drops vertices no face references, keeping the order of the others.
 TriMesh remove_unreferenced_vertices(const TriMesh& mesh);
 
-/// Throws unless the mesh is a disk or a closed genus-0 surface, saying what was found
-/// and what to do. Used by every algorithm that parameterizes.
+/// Throws unless the mesh is a disk or a closed genus-0 surface with consistently oriented
+/// faces, saying what was found and what to do. Used by every algorithm that parameterizes.
 /// \throw TopologyError naming the defect.
 void require_disk_or_sphere(const TopologyReport& report, const std::string& what);
 

@@ -426,9 +426,6 @@ int remove_independent_set(WorkingMesh& K, int target, const MapsOptions& option
 void require_input(const TriMesh& input) {
   const TopologyReport report = topology_report(input);
   require_disk_or_sphere(report, "the mesh to simplify (MAPS)");
-  if (report.inconsistently_oriented_edges > 0)
-    throw TopologyError("the mesh to simplify (MAPS) has " + std::to_string(report.inconsistently_oriented_edges) +
-                        " inconsistently oriented edges; orient its faces consistently first");
   if (report.referenced_vertices < report.vertices)
     throw TopologyError("the mesh to simplify (MAPS) has " +
                         std::to_string(report.vertices - report.referenced_vertices) +

@@ -17,6 +17,7 @@
 
 #include "mesh/errors.h"
 #include "mesh/vertex_stars.h"
+#include "remesh/domain.h"
 #include "remesh/parameterization.h"
 
 namespace mrsnake {
@@ -28,28 +29,22 @@ constexpr double kPi = 3.14159265358979323846;
 /// Surface_mesh (the twin of the first boundary edge in face order), walking against the
 /// faces' orientation.
 std::vector<int> rim_loop(const TriMesh& disk) {
-  const VertexStars stars(disk.F, disk.num_vertices());
+  const std::vector<std::pair<int, int>> rim_edges = boundary_edges(disk.F, VertexStars(disk.F, disk.num_vertices()));
+  if (rim_edges.empty()) throw AlgorithmError("the surface to parameterize has no boundary");
   std::vector<int> rim_next(disk.num_vertices(), -1);
-  int start = -1;
-  std::size_t rim_edges = 0;
-  for (int f = 0; f < disk.num_faces(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int a = disk.F(f, k), b = disk.F(f, (k + 1) % 3);
-      if (face_with_directed_edge(stars, disk.F, b, a) >= 0) continue;
-      if (rim_next[b] >= 0)
-        throw AlgorithmError("the surface to parameterize has a rim that meets itself at vertex " + std::to_string(b) +
-                             ", or faces oriented inconsistently; repair the mesh first");
-      rim_next[b] = a;  // the border halfedge b -> a
-      ++rim_edges;
-      if (start < 0) start = b;
-    }
-  if (start < 0) throw AlgorithmError("the surface to parameterize has no boundary");
+  for (const auto& [a, b] : rim_edges) {
+    if (rim_next[b] >= 0)
+      throw AlgorithmError("the surface to parameterize has a rim that meets itself at vertex " + std::to_string(b) +
+                           ", or faces oriented inconsistently; repair the mesh first");
+    rim_next[b] = a;  // the border halfedge b -> a
+  }
+  const int start = rim_edges.front().second;
   std::vector<int> loop;
   for (int v = start; loop.empty() || v != start; v = rim_next[v]) {
-    if (v < 0 || loop.size() == rim_edges) break;
+    if (v < 0 || loop.size() == rim_edges.size()) break;
     loop.push_back(v);
   }
-  if (loop.size() != rim_edges || rim_next[loop.back()] != start)
+  if (loop.size() != rim_edges.size() || rim_next[loop.back()] != start)
     throw AlgorithmError("the surface to parameterize has more than one boundary loop; it must be a disk");
   return loop;
 }

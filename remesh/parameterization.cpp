@@ -533,9 +533,6 @@ Parameterization parameterize(const TriMesh& input, const ParameterizationOption
   const TriMesh& mesh = param.surface;
   const TopologyReport topo = topology_report(mesh);
   require_disk_or_sphere(topo, "the input surface");
-  if (topo.inconsistently_oriented_edges > 0)
-    throw TopologyError("the input surface has " + std::to_string(topo.inconsistently_oriented_edges) +
-                        " inconsistently oriented edges; orient its faces consistently first");
   const int n = mesh.num_vertices();
   param.domain.resize(n, 3);
   int balance_iterations = 0;

@@ -94,7 +94,8 @@ void reproject_onto(const SurfaceLocator& surface, RowMatrixX3d& X) {
 // simplification of it when it is much finer than the finest level (the parameterization is
 // the costly part).
 
-// \throw TopologyError if the input is neither a disk nor a closed genus-0 surface.
+// \throw TopologyError if the input is neither a disk nor a closed genus-0 surface, or its faces
+// are oriented inconsistently.
 PreparedInput prepare_input(const TriMesh& input, const SimplifyOptions& options, const Resolution& resolution,
                             const ProgressFn& progress, Clock::time_point start) {
   PreparedInput p;

@@ -73,7 +73,8 @@ struct PreparedInput {
   nlohmann::json simplify_info;  ///< simplify_seconds, when a simplification was made
 };
 
-/// \throw TopologyError if the input is neither a disk nor a closed genus-0 surface.
+/// \throw TopologyError if the input is neither a disk nor a closed genus-0 surface, or its faces
+/// are oriented inconsistently.
 PreparedInput prepare_input(const TriMesh& input, const SimplifyOptions& options, const Resolution& resolution,
                             const ProgressFn& progress, Clock::time_point start);
 

@@ -68,6 +68,7 @@ TEST(Topology, FlippedFacesMakeInconsistentlyOrientedEdges) {
   std::swap(one.F(0, 1), one.F(0, 2));
   const auto r = topology_report(one);
   EXPECT_EQ(r.inconsistently_oriented_edges, 3);
+  EXPECT_THROW(require_disk_or_sphere(r, "the icosahedron"), TopologyError);
   EXPECT_EQ(r.edges, 30);
   EXPECT_EQ(r.non_manifold_edges, 0);
   int neighbour = -1;
