@@ -7,6 +7,7 @@
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Edge_length_cost.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Midpoint_placement.h>
 #include <CGAL/Surface_mesh_simplification/edge_collapse.h>
+#include <CGAL/Polygon_mesh_processing/remesh.h>
 
 #include <algorithm>
 #include <array>
@@ -217,6 +218,14 @@ TriMesh simplify_to_faces(const TriMesh& mesh, int target_faces) {
     simplified = simplify_whole(mesh, target_faces);
   }
   return to_trimesh(simplified);
+}
+
+TriMesh remesh_isotropically(const TriMesh& mesh, double edge_length, int iterations) {
+  SurfaceMesh sm = to_surface_mesh(mesh);
+  CGAL::Polygon_mesh_processing::isotropic_remeshing(faces(sm), edge_length, sm,
+                                                     CGAL::parameters::number_of_iterations(iterations));
+  sm.collect_garbage();
+  return to_trimesh(sm);
 }
 
 TriMesh detail::simplify_in_two_halves(const TriMesh& mesh, int target_faces) {

@@ -45,6 +45,7 @@ void check_resolution_and_relaxation(const RemeshOptions& o, const std::string& 
   if (o.levels == 0) require_at_least(at + "target_faces", o.target_faces, 16);
   require_at_least(at + "base_vertices", o.base_vertices, 6);
   require_at_least(at + "simplify.above_faces", o.simplify.above_faces, 0);
+  require_in(at + "simplify.sliver_share", o.simplify.sliver_share, 0.0, 1.0);
   require_at_least(at + "relaxation.lloyd_iterations", o.relaxation.lloyd_iterations, 0);
   require_at_least(at + "relaxation.shape_iterations", o.relaxation.shape_iterations, 0);
   require_at_least(at + "relaxation.guarded_shape_iterations", o.relaxation.guarded_shape_iterations, 0);

@@ -135,6 +135,12 @@ struct SimplifyOptions {
   /// Inputs with more faces than max(above_faces, 8 x the finest level's faces) are simplified
   /// to that size; the levels are then projected back onto the original. 0 = never simplify.
   int above_faces = 100000;
+  /// An input with more than this share of large slivers (triangles of Q < 0.3 with an edge
+  /// longer than the finest level's) is remeshed isotropically first (CGAL, 3 iterations, the
+  /// finest level's edge length), and the levels are projected back onto the original. The
+  /// lift is affine on each input triangle, so a large sliver shears the level's triangles over
+  /// it, and on the base-mesh domain no chart holds one longer than a base star. 1 = never.
+  double sliver_share = 0.05;
 };
 
 /// Options of remesh(). Either `levels` or `target_faces` chooses the resolution. Everything

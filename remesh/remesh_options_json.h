@@ -23,7 +23,7 @@ void from_json(const nlohmann::json& j, ParameterDomain& domain);
 void to_json(nlohmann::json& j, SphereMap map);
 void from_json(const nlohmann::json& j, SphereMap& map);
 
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SimplifyOptions, above_faces)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SimplifyOptions, above_faces, sliver_share)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SizingOptions, curvature_weight, curvature_exponent, density_exponent)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(BaseMeshOptions, density_exponent, density_smoothing, max_bend,
                                                 rim_min_triangles, one_chart_flip_margin_deg)

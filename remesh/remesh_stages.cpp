@@ -90,9 +90,35 @@ void reproject_onto(const SurfaceLocator& surface, RowMatrixX3d& X) {
   });
 }
 
+namespace {
+
+// The share of the triangles of Q < 0.3 with an edge longer than `edge`: slivers larger than
+// the finest level's triangles, such as decimation leaves along a limb.
+double sliver_share(const TriMesh& mesh, double edge) {
+  int slivers = 0;
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    slivers += longest > edge && frey_borouchaki_quality(a, b, c) < 0.3;
+  }
+  return mesh.num_faces() > 0 ? static_cast<double>(slivers) / mesh.num_faces() : 0.0;
+}
+
+// The edge length of `faces` equilateral triangles that cover the mesh's area.
+double equilateral_edge(const TriMesh& mesh, double faces) {
+  double area = 0;
+  for (int f = 0; f < mesh.num_faces(); ++f)
+    area += 0.5 * (mesh.V.row(mesh.F(f, 1)) - mesh.V.row(mesh.F(f, 0)))
+                      .cross(mesh.V.row(mesh.F(f, 2)) - mesh.V.row(mesh.F(f, 0)))
+                      .norm();
+  return std::sqrt(4.0 * area / (std::sqrt(3.0) * faces));
+}
+
+}  // namespace
+
 // The input as it is parameterized: the original without unreferenced vertices, or a
 // simplification of it when it is much finer than the finest level (the parameterization is
-// the costly part).
+// the costly part), or an isotropic remeshing of it when it is made of slivers.
 
 // \throw TopologyError if the input is neither a disk nor a closed genus-0 surface, or its faces
 // are oriented inconsistently.
@@ -105,15 +131,26 @@ PreparedInput prepare_input(const TriMesh& input, const SimplifyOptions& options
   p.work = p.original;
   const double finest_faces = 2.0 * resolution.base_vertices * std::pow(4.0, resolution.levels);
   const double limit = std::max<double>(options.above_faces, 8 * finest_faces);
+  // A stand-in for the original is kept only if it has the original's topology.
+  const auto stand_in = [&](TriMesh mesh) {
+    const TopologyReport after = topology_report(mesh);
+    if (after.is_disk() != topology.is_disk() || after.is_closed_genus0() != topology.is_closed_genus0()) return false;
+    p.work = std::move(mesh);
+    p.simplified = true;
+    return true;
+  };
   if (options.above_faces > 0 && p.original.num_faces() > limit) {
     report(progress, "simplify", 0);
-    TriMesh simplified_mesh = simplify_to_faces(p.original, static_cast<int>(limit));
+    stand_in(simplify_to_faces(p.original, static_cast<int>(limit)));
     p.simplify_info["simplify_seconds"] = seconds_since(start);
-    const TopologyReport after = topology_report(simplified_mesh);
-    if (after.is_disk() == topology.is_disk() && after.is_closed_genus0() == topology.is_closed_genus0()) {
-      p.work = std::move(simplified_mesh);
-      p.simplified = true;
-    }
+    return p;
+  }
+  const double finest_edge = equilateral_edge(p.original, finest_faces);
+  const double slivers = sliver_share(p.original, finest_edge);
+  if (slivers > options.sliver_share) {
+    report(progress, "remesh the slivers", 0);
+    if (stand_in(remesh_isotropically(p.original, finest_edge, 3))) p.simplify_info["sliver_share"] = slivers;
+    p.simplify_info["sliver_remesh_seconds"] = seconds_since(start);
   }
   return p;
 }

@@ -64,13 +64,14 @@ struct SizingFields {
 SizingFields sizing_fields(const TriMesh& surface, const SizingOptions& sizing, const BaseMeshOptions& base,
                            bool levels_given, Resolution& resolution);
 
-/// The input as it is parameterized: the original without unreferenced vertices, or a
-/// simplification of it when it is much finer than the finest level.
+/// The input as it is parameterized: the original without unreferenced vertices, a
+/// simplification of it when it is much finer than the finest level, or an isotropic remeshing
+/// of it when more than SimplifyOptions::sliver_share of its triangles are slivers.
 struct PreparedInput {
   TriMesh original;
   TriMesh work;
-  bool simplified = false;
-  nlohmann::json simplify_info;  ///< simplify_seconds, when a simplification was made
+  bool simplified = false;       ///< work stands in for the original: levels are projected back onto it
+  nlohmann::json simplify_info;  ///< simplify_seconds, or sliver_share and sliver_remesh_seconds
 };
 
 /// \throw TopologyError if the input is neither a disk nor a closed genus-0 surface, or its faces

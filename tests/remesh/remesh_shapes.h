@@ -57,15 +57,16 @@ inline TriMesh flat_grid(int n, double nudge = 0.0) {
 }
 
 // A capsule along z: a tube of radius 1 and the given length with hemispherical caps, `around`
-// vertices per ring. From a length of about 15, a one-chart conformal map squeezes its far
-// end by more than 12 orders of magnitude in area.
-inline TriMesh capsule(double length, int around = 16) {
+// vertices per ring, the tube's rings `ring_spacing` apart (0: as far as the ring's vertices,
+// so that its triangles are about isosceles right). From a length of about 15, a one-chart
+// conformal map squeezes its far end by more than 12 orders of magnitude in area.
+inline TriMesh capsule(double length, int around = 16, double ring_spacing = 0.0) {
   const double pi = 3.14159265358979323846;
   std::vector<std::pair<double, double>> rings;  // (z, radius), bottom to top
   const int cap_rings = around / 4;
   for (int i = 1; i <= cap_rings; ++i)
     rings.emplace_back(-std::cos(0.5 * pi * i / cap_rings), std::sin(0.5 * pi * i / cap_rings));
-  const int tube = static_cast<int>(std::lround(length / (2 * pi / around)));
+  const int tube = static_cast<int>(std::lround(length / (ring_spacing > 0 ? ring_spacing : 2 * pi / around)));
   for (int j = 1; j <= tube; ++j) rings.emplace_back(length * j / tube, 1.0);
   for (int i = 1; i < cap_rings; ++i)
     rings.emplace_back(length + std::sin(0.5 * pi * i / cap_rings), std::cos(0.5 * pi * i / cap_rings));

@@ -133,6 +133,27 @@ TEST(Remesh, FineInputIsSimplifiedThenProjectedBackOntoIt) {
   expect_nested_and_valid(r, input, true);  // includes: every vertex lies on the original input (the finest near it)
 }
 
+TEST(Remesh, AnInputOfLargeSliversIsRemeshedIsotropicallyThenProjectedBackOntoIt) {
+  // The tube's triangles are 4 long and 0.39 wide (Q 0.15), as decimation leaves a limb: the
+  // lift, affine on each, shears the level's triangles over them.
+  const TriMesh input = test::capsule(20.0, 16, 4.0);
+  RemeshOptions o;
+  o.target_faces = 4000;
+  const RemeshResult remeshed = remesh(input, o);
+  EXPECT_NEAR(remeshed.parameterization["sliver_share"].get<double>(), 160.0 / 384.0, 1e-12);
+  EXPECT_GT(remeshed.parameterization["parameterized_faces"].get<int>(), 10 * input.num_faces());
+  expect_nested_and_valid(remeshed, input, true);  // includes: every vertex lies on the original input
+  o.simplify.sliver_share = 1.0;
+  const RemeshResult kept = remesh(input, o);
+  EXPECT_FALSE(kept.parameterization.contains("sliver_share"));
+  EXPECT_EQ(kept.parameterization["parameterized_faces"].get<int>(), input.num_faces());
+  // What the isotropic input buys: rounder triangles at the finest level.
+  const double q_remeshed = remeshed.levels.back().stats["quality"]["q_mean"].get<double>();
+  const double q_kept = kept.levels.back().stats["quality"]["q_mean"].get<double>();
+  EXPECT_GT(q_remeshed, 0.9);
+  EXPECT_LT(q_kept, 0.6);
+}
+
 // Edges of (V, F) shorter than `length`, each counted once.
 int edges_shorter_than(const TriMesh& mesh, double length) {
   int count = 0;
