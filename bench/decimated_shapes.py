@@ -8,7 +8,7 @@ benchmark's (docs/remesh.md, "Large slivers").
 writes cow.ply, hand.ply, kidney.ply and caudate.ply (an implicit shape, marching cubes on a 160^3
 grid, the largest component, VTK's quadric decimation to 5 % of the faces) and capsule-3.off and
 capsule-4.off (a tube of radius 1 and length 20 with hemispherical caps, 16 vertices per ring,
-rings 3 or 4 apart: tube triangles of Q 0.21 and 0.15).
+the tube's rings 20/7 or 4 apart: tube triangles of Q 0.22 and 0.16).
 """
 import math
 import os

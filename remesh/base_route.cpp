@@ -106,7 +106,7 @@ struct BaseContext {
   const BaseLift& lift;
   const TriMesh& original;
   const SurfaceLocator* locator;    ///< the original's closest points, if built
-  const SurfaceLocator* reproject;  ///< the same, when a simplification was parameterized; else null
+  const SurfaceLocator* reproject;  ///< the same, when a stand-in for the input was parameterized; else null
   const SubdivisionConnectivity& connectivity;
   const Eigen::VectorXd& wanted;  ///< the wanted 3D point density per vertex of the parameterized input
 };
@@ -190,7 +190,7 @@ nlohmann::json repair_level_on_base(const BaseContext& ctx, const RepairOptions&
 }
 
 // Level j: laid out (lay_out_level); on the finest level its tips snapped and its worst
-// triangles repaired; back onto the original when a simplification was parameterized; the
+// triangles repaired; back onto the original when a stand-in for it was parameterized; the
 // flip test in D; and the fit of the finest level.
 // \throw AlgorithmError if a triangle is flipped in D.
 RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& options, int j, LevelStart& start,

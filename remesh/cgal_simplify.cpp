@@ -1,4 +1,4 @@
-// CGAL adapter: edge-collapse simplification.
+// CGAL adapter: edge-collapse simplification, and isotropic remeshing.
 #include <CGAL/Simple_cartesian.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Bounded_normal_change_filter.h>
@@ -224,7 +224,6 @@ TriMesh remesh_isotropically(const TriMesh& mesh, double edge_length, int iterat
   SurfaceMesh sm = to_surface_mesh(mesh);
   CGAL::Polygon_mesh_processing::isotropic_remeshing(faces(sm), edge_length, sm,
                                                      CGAL::parameters::number_of_iterations(iterations));
-  sm.collect_garbage();
   return to_trimesh(sm);
 }
 

@@ -119,7 +119,7 @@ nlohmann::json parameterization_summary(const MappedInput& mapped, const Prepare
   if (input.simplify_info.is_object()) summary.update(input.simplify_info);
   summary["input_faces"] = input.original.num_faces();
   summary["parameterized_faces"] = input.work.num_faces();
-  summary["seconds"] = seconds_since(start);  // input checks and simplification included
+  summary["seconds"] = seconds_since(start);  // input checks and any stand-in for the input included
   return summary;
 }
 
@@ -169,7 +169,7 @@ struct LevelContext {
   const Eigen::VectorXd& wanted;    ///< the wanted 3D density per vertex of the parameterized surface
   const TriMesh& original;          ///< the input without unreferenced vertices
   const SurfaceLocator* locator;    ///< its closest points, if built
-  const SurfaceLocator* reproject;  ///< the same, when a simplification was parameterized; else null
+  const SurfaceLocator* reproject;  ///< the same, when a stand-in for the input was parameterized; else null
   const SubdivisionConnectivity& connectivity;
   int fit_rounds;  ///< 0 unless the full method fits the finest level
 };
@@ -321,7 +321,8 @@ nlohmann::json level_stats(int j, const RemeshLevel& level, const RowMatrixX3i& 
 
 // Level j: split (j > 0), relax in D and on the surface; with the full method, snap the tips
 // (finest level), repair, and fit (finest level); the projection onto the original input when a
-// simplification was parameterized. `extra_seconds` is added to the level's time.
+// stand-in for it (a simplification, a sliver remeshing) was parameterized. `extra_seconds` is
+// added to the level's time.
 // \throw AlgorithmError if a triangle is flipped in D.
 RemeshLevel build_level(const LevelContext& ctx, const RemeshOptions& options, int j, DomainLayout& layout,
                         double extra_seconds) {

@@ -123,23 +123,25 @@ struct RepairOptions {
   bool guard_finest = true;
   /// The guard lets triangles move away from the surface by up to this x the mean edge length.
   double error_tolerance = 0.03;
-  /// With a simplified input: project each level onto the original input before the repair
+  /// With a simplified or sliver-remeshed input: project each level onto the original input before the repair
   /// (which then moves vertices on the original) instead of after it, so that the repair sees
   /// the triangles the projection shears. The base-mesh domain repairs on the surface it
   /// parameterized, then projects (its repair moves vertices in its charts), either way.
   bool after_reprojection = true;
 };
 
-/// The simplification of a fine input before the parameterization (remesh/simplify.h).
+/// The simplification of a fine input, or the isotropic remeshing of one made of large slivers,
+/// before the parameterization (remesh/simplify.h).
 struct SimplifyOptions {
   /// Inputs with more faces than max(above_faces, 8 x the finest level's faces) are simplified
   /// to that size; the levels are then projected back onto the original. 0 = never simplify.
   int above_faces = 100000;
   /// An input with more than this share of large slivers (triangles of Q < 0.3 with an edge
-  /// longer than the finest level's) is remeshed isotropically first (CGAL, 3 iterations, the
-  /// finest level's edge length), and the levels are projected back onto the original. The
-  /// lift is affine on each input triangle, so a large sliver shears the level's triangles over
-  /// it, and on the base-mesh domain no chart holds one longer than a base star. 1 = never.
+  /// longer than the finest level's: that of equilateral triangles covering the input's area in
+  /// the finest level's face count) is remeshed isotropically first (CGAL, 3 iterations, toward
+  /// that edge), and the levels are projected back onto the original. The lift is affine on each
+  /// input triangle, so a large sliver shears the level's triangles over it, and on the
+  /// base-mesh domain no chart holds one longer than a base star. 1 = never.
   double sliver_share = 0.05;
 };
 

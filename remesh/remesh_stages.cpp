@@ -114,11 +114,35 @@ double equilateral_edge(const TriMesh& mesh, double faces) {
   return std::sqrt(4.0 * area / (std::sqrt(3.0) * faces));
 }
 
+// Puts `mesh` in for the original if it has the original's topology. \return whether it did.
+bool stand_in(const TopologyReport& topology, TriMesh mesh, PreparedInput& p) {
+  const TopologyReport after = topology_report(mesh);
+  if (after.is_disk() != topology.is_disk() || after.is_closed_genus0() != topology.is_closed_genus0()) return false;
+  p.work = std::move(mesh);
+  p.simplified = true;
+  return true;
+}
+
+// An input of large slivers, remeshed isotropically to stand in for it (SimplifyOptions::
+// sliver_share). simplify_info gets the share, whether the remeshing stood in (it must keep the
+// topology), and sliver_remesh_seconds, the time since the run's start.
+void remesh_large_slivers(const TopologyReport& topology, const SimplifyOptions& options, double finest_faces,
+                          const ProgressFn& progress, Clock::time_point start, PreparedInput& p) {
+  const double finest_edge = equilateral_edge(p.original, finest_faces);
+  if (!(finest_edge > 0)) return;  // no area: the parameterization refuses it
+  const double share = sliver_share(p.original, finest_edge);
+  if (share <= options.sliver_share) return;
+  report(progress, "remesh the slivers", 0);
+  p.simplify_info["sliver_share"] = share;
+  p.simplify_info["sliver_remeshed"] = stand_in(topology, remesh_isotropically(p.original, finest_edge, 3), p);
+  p.simplify_info["sliver_remesh_seconds"] = seconds_since(start);
+}
+
 }  // namespace
 
 // The input as it is parameterized: the original without unreferenced vertices, or a
 // simplification of it when it is much finer than the finest level (the parameterization is
-// the costly part), or an isotropic remeshing of it when it is made of slivers.
+// the costly part), or an isotropic remeshing of it when it is made of large slivers.
 
 // \throw TopologyError if the input is neither a disk nor a closed genus-0 surface, or its faces
 // are oriented inconsistently.
@@ -131,27 +155,13 @@ PreparedInput prepare_input(const TriMesh& input, const SimplifyOptions& options
   p.work = p.original;
   const double finest_faces = 2.0 * resolution.base_vertices * std::pow(4.0, resolution.levels);
   const double limit = std::max<double>(options.above_faces, 8 * finest_faces);
-  // A stand-in for the original is kept only if it has the original's topology.
-  const auto stand_in = [&](TriMesh mesh) {
-    const TopologyReport after = topology_report(mesh);
-    if (after.is_disk() != topology.is_disk() || after.is_closed_genus0() != topology.is_closed_genus0()) return false;
-    p.work = std::move(mesh);
-    p.simplified = true;
-    return true;
-  };
   if (options.above_faces > 0 && p.original.num_faces() > limit) {
     report(progress, "simplify", 0);
-    stand_in(simplify_to_faces(p.original, static_cast<int>(limit)));
+    stand_in(topology, simplify_to_faces(p.original, static_cast<int>(limit)), p);
     p.simplify_info["simplify_seconds"] = seconds_since(start);
     return p;
   }
-  const double finest_edge = equilateral_edge(p.original, finest_faces);
-  const double slivers = sliver_share(p.original, finest_edge);
-  if (slivers > options.sliver_share) {
-    report(progress, "remesh the slivers", 0);
-    if (stand_in(remesh_isotropically(p.original, finest_edge, 3))) p.simplify_info["sliver_share"] = slivers;
-    p.simplify_info["sliver_remesh_seconds"] = seconds_since(start);
-  }
+  remesh_large_slivers(topology, options, finest_faces, progress, start, p);
   return p;
 }
 

@@ -71,7 +71,7 @@ struct PreparedInput {
   TriMesh original;
   TriMesh work;
   bool simplified = false;       ///< work stands in for the original: levels are projected back onto it
-  nlohmann::json simplify_info;  ///< simplify_seconds, or sliver_share and sliver_remesh_seconds
+  nlohmann::json simplify_info;  ///< simplify_seconds, or sliver_share, sliver_remeshed and sliver_remesh_seconds
 };
 
 /// \throw TopologyError if the input is neither a disk nor a closed genus-0 surface, or its faces

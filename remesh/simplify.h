@@ -16,8 +16,6 @@ namespace mrsnake {
 /// \throw AlgorithmError if CGAL cannot build or simplify the surface.
 TriMesh simplify_to_faces(const TriMesh& mesh, int target_faces);
 
-TriMesh remesh_isotropically(const TriMesh& mesh, double edge_length, int iterations);
-
 /// CGAL's isotropic remeshing of `mesh` toward `edge_length` (splits, collapses, flips toward
 /// valence 6, tangential relaxation), `iterations` rounds; a disk's rim is remeshed too.
 /// \pre mesh is a manifold disk or closed genus-0 surface; edge_length > 0.
