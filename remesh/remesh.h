@@ -123,10 +123,10 @@ struct RepairOptions {
   bool guard_finest = true;
   /// The guard lets triangles move away from the surface by up to this x the mean edge length.
   double error_tolerance = 0.03;
-  /// With a simplified or sliver-remeshed input: project each level onto the original input before the repair
-  /// (which then moves vertices on the original) instead of after it, so that the repair sees
-  /// the triangles the projection shears. The base-mesh domain repairs on the surface it
-  /// parameterized, then projects (its repair moves vertices in its charts), either way.
+  /// With a simplified or sliver-remeshed input: project each level onto the original input
+  /// before the repair (which then moves vertices on the original) instead of after it, so that
+  /// the repair sees the triangles the projection shears. The base-mesh domain repairs on the
+  /// surface it parameterized, then projects (its repair moves vertices in its charts), either way.
   bool after_reprojection = true;
 };
 
