@@ -191,7 +191,7 @@ nlohmann::json repair_level_on_base(const BaseContext& ctx, const RepairOptions&
 
 // Level j: laid out (lay_out_level); on the finest level its tips snapped and its worst
 // triangles repaired; back onto the original when a stand-in for it was parameterized; the
-// flip test in D; and the fit of the finest level.
+// flip test in D; and the fit and the untangling of the finest level.
 // \throw AlgorithmError if a triangle is flipped in D.
 RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& options, int j, LevelStart& start,
                              double extra_seconds) {
@@ -227,6 +227,9 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
         stage_seconds, "fit", [&] { return fit_to_surface(F, level.positions, *ctx.locator, options.fit, fixed); });
     fit = {{"rms_before_mm", s.rms_before}, {"rms_after_mm", s.rms_after}, {"max_offset_mm", s.max_offset}};
   }
+  nlohmann::json untangle;
+  if (finest_full && options.untangle.max_rounds > 0)
+    untangle = timed(stage_seconds, "untangle", [&] { return untangle_finest(F, level.positions, options.untangle); });
   level.domain_positions.resize(layout.points.size(), 3);
   for (std::size_t v = 0; v < layout.points.size(); ++v)
     level.domain_positions.row(v) = ctx.domain.position(layout.points[v]).transpose();
@@ -243,6 +246,7 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
                  {"started_from", laid_out.from_dyadic ? "dyadic split" : "relaxed split"}};
   if (!fit.is_null()) level.stats["fit"] = fit;
   if (!repair.is_null()) level.stats["repair"] = repair;
+  if (!untangle.is_null()) level.stats["untangle"] = untangle;
   if (j == ctx.connectivity.levels()) level.stats["snapped_vertices"] = snaps;
   if (options.compute_stats && ctx.locator) measure_level(ctx.original, *ctx.locator, F, level);
   return level;

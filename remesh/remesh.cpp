@@ -80,6 +80,7 @@ void check_sizing_and_finish(const RemeshOptions& o, const std::string& at) {
   require_at_least(at + "fit.max_offset", o.fit.max_offset, 0.0);
   require_positive(at + "fit.max_sample_distance", o.fit.max_sample_distance);
   require_in(at + "fit.quality_floor", o.fit.quality_floor, 0.0, 1.0);
+  require_at_least(at + "untangle.max_rounds", o.untangle.max_rounds, 0);
   require_at_least(at + "repair.sweeps", o.repair.sweeps, 0);
   require_positive(at + "repair.threshold", o.repair.threshold);
   require_in(at + "repair.threshold", o.repair.threshold, 0.0, 1.0);
@@ -291,6 +292,7 @@ struct LevelRecord {
   TriangleRepairStats repair;
   bool fitted = false;
   SurfaceFitStats fit;
+  nlohmann::json untangle;                                  ///< null unless the finest level had crossing face pairs
   nlohmann::json stage_seconds = nlohmann::json::object();  ///< per stage that ran
 };
 
@@ -312,6 +314,7 @@ nlohmann::json level_stats(int j, const RemeshLevel& level, const RowMatrixX3i& 
     s["fit"] = {{"rms_before_mm", r.fit.rms_before},          {"rms_after_mm", r.fit.rms_after},
                 {"mean_offset_mm", r.fit.mean_offset},        {"max_offset_mm", r.fit.max_offset},
                 {"clamped_vertices", r.fit.clamped_vertices}, {"held_vertices", r.fit.held_vertices}};
+  if (!r.untangle.is_null()) s["untangle"] = r.untangle;
   if (r.repair.moves > 0) {
     s["repair_q_min_before"] = r.repair.q_min_before;
     s["repair_q_min_after"] = r.repair.q_min_after;
@@ -320,7 +323,7 @@ nlohmann::json level_stats(int j, const RemeshLevel& level, const RowMatrixX3i& 
 }
 
 // Level j: split (j > 0), relax in D and on the surface; with the full method, snap the tips
-// (finest level), repair, and fit (finest level); the projection onto the original input when a
+// (finest level), repair, fit and untangle (finest level); the projection onto the original input when a
 // stand-in for it (a simplification, a sliver remeshing) was parameterized. `extra_seconds` is
 // added to the level's time.
 // \throw AlgorithmError if a triangle is flipped in D.
@@ -360,6 +363,8 @@ RemeshLevel build_level(const LevelContext& ctx, const RemeshOptions& options, i
   r.fitted = ctx.fit_rounds > 0 && finest;
   if (r.fitted)
     r.fit = timed(stage, "fit", [&] { return fit_finest(ctx, options.fit, j, snapped, r.snapped, level.positions); });
+  if (full && finest && options.untangle.max_rounds > 0)
+    r.untangle = timed(stage, "untangle", [&] { return untangle_finest(F, level.positions, options.untangle); });
   level.domain_positions = layout.U;
   level.flipped_triangles = flipped;
   level.seconds = seconds_since(start) + extra_seconds;
@@ -596,6 +601,7 @@ RemeshOptions options_as_run(const RemeshResult& result, RemeshOptions options) 
     options.relaxation.smooth_rim = false;
     options.snap.max_snaps = 0;
     options.fit.rounds = 0;
+    options.untangle.max_rounds = 0;
     options.repair.sweeps = 0;
   }
   if (result.domain != "base_mesh") options.relaxation.guarded_shape_iterations = 0;

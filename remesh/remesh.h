@@ -21,6 +21,7 @@
 #include "remesh/feature_snap.h"
 #include "remesh/parameterization.h"
 #include "remesh/surface_fit.h"
+#include "remesh/untangle.h"
 
 namespace mrsnake {
 
@@ -146,7 +147,7 @@ struct SimplifyOptions {
 };
 
 /// Options of remesh(). Either `levels` or `target_faces` chooses the resolution. Everything
-/// up to `fit` is the method (JSON: remesh/remesh_options_json.h, the form of
+/// up to `untangle` is the method (JSON: remesh/remesh_options_json.h, the form of
 /// `mrsnake remesh --config` and of report.json's "options"); the rest is for the caller only.
 struct RemeshOptions {
   /// Number of 1:4 splits L (> 0), or 0 to derive it from target_faces.
@@ -179,6 +180,10 @@ struct RemeshOptions {
   /// vertices sit on the input, so every triangle is a chord; the fit centres the triangles on
   /// the surface. fit.rounds = 0: every vertex stays exactly on the input, as in the paper.
   SurfaceFitOptions fit;
+  /// With all_vertices, last on the finest level: the vertices of self-intersecting face pairs
+  /// move to their neighbours' mean while the count of such pairs falls (remesh/untangle.h), which
+  /// opens the folds a level makes around parts thinner than its edges. max_rounds = 0: off.
+  UntangleOptions untangle;
 
   // For the caller only; not part of the method, not in the JSON.
   /// Build RemeshResult::input_locator even if nothing here needs it (a caller that measures

@@ -36,8 +36,9 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RepairOptions, sweeps, threshold
                                                 error_tolerance, after_reprojection)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(SurfaceFitOptions, rounds, regularization, max_offset,
                                                 max_sample_distance, quality_floor)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(UntangleOptions, max_rounds)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RemeshOptions, levels, target_faces, base_vertices, relax, domain,
                                                 sphere_map, base_mesh_alone_when_squeezed, simplify, sizing, base,
-                                                relaxation, snap, repair, fit)
+                                                relaxation, snap, repair, fit, untangle)
 
 }  // namespace mrsnake

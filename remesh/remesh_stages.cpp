@@ -6,8 +6,10 @@
 #include "mesh/parallel.h"
 #include "mesh/quality.h"
 #include "mesh/topology.h"
+#include "remesh/domain.h"
 #include "remesh/simplify.h"
 #include "remesh/sizing.h"
+#include "remesh/untangle.h"
 
 namespace mrsnake::remesh_stages {
 
@@ -163,6 +165,15 @@ PreparedInput prepare_input(const TriMesh& input, const SimplifyOptions& options
   }
   remesh_large_slivers(topology, options, finest_faces, progress, start, p);
   return p;
+}
+
+nlohmann::json untangle_finest(const RowMatrixX3i& F, RowMatrixX3d& X, const UntangleOptions& options) {
+  const UntangleStats s = untangle_self_intersections(F, X, boundary_vertices(F, static_cast<int>(X.rows())), options);
+  if (s.pairs_before == 0) return nullptr;
+  return {{"pairs_before", s.pairs_before},
+          {"pairs_after", s.pairs_after},
+          {"rounds", s.rounds},
+          {"moved_vertices", s.moved_vertices}};
 }
 
 // Quality, distance to the input and crossing face pairs, into the level's stats. Metro-style

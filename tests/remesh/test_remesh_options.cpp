@@ -40,7 +40,7 @@ TEST(RemeshOptionsJson, DefaultsRoundTrip) {
   const nlohmann::json defaults = RemeshOptions{};
   EXPECT_EQ(nlohmann::json(options_from_json<RemeshOptions>(defaults)), defaults);
   // Every stage's options are there, nested, and the enums are strings.
-  for (const char* key : {"simplify", "sizing", "base", "relaxation", "snap", "repair", "fit"})
+  for (const char* key : {"simplify", "sizing", "base", "relaxation", "snap", "repair", "fit", "untangle"})
     EXPECT_TRUE(defaults.at(key).is_object()) << key;
   EXPECT_EQ(defaults.at("relax"), "all_vertices");
   EXPECT_EQ(defaults.at("sphere_map"), "automatic");
@@ -196,6 +196,9 @@ TEST(RemeshOptionsCheck, AValueOutOfRangeIsRefusedByItsKeyWithThePrefix) {
   o = RemeshOptions{};
   o.fit.regularization = 0;
   EXPECT_EQ(refusal(o), "the option fit.regularization is 0; it must be a positive number");
+  o = RemeshOptions{};
+  o.untangle.max_rounds = -1;
+  EXPECT_NE(refusal(o).find("the option untangle.max_rounds is -1"), std::string::npos) << refusal(o);
 }
 
 TEST_F(RemeshConfigCli, ReportOptionsRepeatTheRunExactly) {
