@@ -323,9 +323,9 @@ nlohmann::json level_stats(int j, const RemeshLevel& level, const RowMatrixX3i& 
 }
 
 // Level j: split (j > 0), relax in D and on the surface; with the full method, snap the tips
-// (finest level), repair, fit and untangle (finest level); the projection onto the original input when a
-// stand-in for it (a simplification, a sliver remeshing) was parameterized. `extra_seconds` is
-// added to the level's time.
+// (finest level), repair, fit and untangle (finest level); the projection onto the original
+// input when a stand-in for it (a simplification, a sliver remeshing) was parameterized.
+// `extra_seconds` is added to the level's time.
 // \throw AlgorithmError if a triangle is flipped in D.
 RemeshLevel build_level(const LevelContext& ctx, const RemeshOptions& options, int j, DomainLayout& layout,
                         double extra_seconds) {

@@ -180,9 +180,9 @@ struct RemeshOptions {
   /// vertices sit on the input, so every triangle is a chord; the fit centres the triangles on
   /// the surface. fit.rounds = 0: every vertex stays exactly on the input, as in the paper.
   SurfaceFitOptions fit;
-  /// With all_vertices, last on the finest level: the vertices of self-intersecting face pairs
-  /// move to their neighbours' mean while the count of such pairs falls (remesh/untangle.h), which
-  /// opens the folds a level makes around parts thinner than its edges. max_rounds = 0: off.
+  /// With all_vertices, last on the finest level: the corners of crossing face pairs move to
+  /// their neighbours' mean while the count of such pairs falls (remesh/untangle.h), which opens
+  /// the folds a level makes around parts thinner than its edges. max_rounds = 0: off.
   UntangleOptions untangle;
 
   // For the caller only; not part of the method, not in the JSON.

@@ -10,7 +10,7 @@
 /// The pairs are crossing_face_pairs (mesh/distance.h): faces that share no vertex. Neighbours
 /// that overlap in a fold have crossing faces beside them, and open with them (on the octopus and
 /// the human figure of bench/remesh, count_self_intersections after the stage is the same as with
-/// it run on every pair, in half the time).
+/// it run on every pair, in half to two thirds of the time).
 #include <vector>
 
 #include "mesh/trimesh.h"
@@ -18,8 +18,8 @@
 namespace mrsnake {
 
 struct UntangleOptions {
-  /// Rounds at most; the rounds stop as soon as one would not lower the count of intersecting
-  /// face pairs. 0 = off.
+  /// Rounds at most; the rounds stop as soon as one would not lower the count of crossing face
+  /// pairs. 0 = off.
   int max_rounds = 10;
 };
 
