@@ -51,8 +51,7 @@ void add_fit_rounds_option(CLI::App& command, int& rounds) {
       .add_option(
           "--fit-rounds", rounds,
           "Rounds of the least-squares fit of the finest level to the input along the vertex normals (default " +
-              std::to_string(rounds) + "; 0 = off: every vertex stays on the input; the full method only, " +
-              "not with --strict or --no-relax)")
+              std::to_string(rounds) + "; 0 = off; the full method only, not with --strict or --no-relax)")
       ->check(CLI::Range(0, 100));
 }
 

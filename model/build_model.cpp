@@ -22,7 +22,8 @@ namespace mrsnake {
 
 RemeshOptions model_remesh_preset() {
   RemeshOptions o;
-  o.fit.rounds = 0;                 // the vertices stay on the reference surface
+  o.fit.rounds = 0;                 // the vertices stay on the reference surface,
+  o.untangle.max_rounds = 0;        // even where the finest level crosses itself (a warning)
   o.sizing.curvature_weight = 1.0;  // denser where the organ bends
   o.keep_input_locator = true;      // the report page measures every level against the input
   return o;

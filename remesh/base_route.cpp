@@ -197,7 +197,8 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
                              double extra_seconds) {
   const auto clock_start = Clock::now();
   const RowMatrixX3i& F = ctx.connectivity.faces[j];
-  // The snap, the repair and the fit run on the finest level, and with the full method only.
+  // The snap, the repair, the fit and the untangling run on the finest level, and with the full
+  // method only.
   const bool finest_full = options.relax == RelaxMode::all_vertices && j == ctx.connectivity.levels();
   nlohmann::json stage_seconds = nlohmann::json::object();
   LaidOutLevel laid_out = timed(stage_seconds, "lay_out", [&] { return lay_out_level(ctx, options, j, start); });
@@ -229,7 +230,8 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
   }
   nlohmann::json untangle;
   if (finest_full && options.untangle.max_rounds > 0)
-    untangle = timed(stage_seconds, "untangle", [&] { return untangle_finest(F, level.positions, options.untangle); });
+    untangle = timed(stage_seconds, "untangle",
+                     [&] { return untangle_finest(F, level.positions, options.untangle, snapped); });
   level.domain_positions.resize(layout.points.size(), 3);
   for (std::size_t v = 0; v < layout.points.size(); ++v)
     level.domain_positions.row(v) = ctx.domain.position(layout.points[v]).transpose();

@@ -364,7 +364,8 @@ RemeshLevel build_level(const LevelContext& ctx, const RemeshOptions& options, i
   if (r.fitted)
     r.fit = timed(stage, "fit", [&] { return fit_finest(ctx, options.fit, j, snapped, r.snapped, level.positions); });
   if (full && finest && options.untangle.max_rounds > 0)
-    r.untangle = timed(stage, "untangle", [&] { return untangle_finest(F, level.positions, options.untangle); });
+    r.untangle =
+        timed(stage, "untangle", [&] { return untangle_finest(F, level.positions, options.untangle, snapped); });
   level.domain_positions = layout.U;
   level.flipped_triangles = flipped;
   level.seconds = seconds_since(start) + extra_seconds;
@@ -590,9 +591,9 @@ void measure_levels(const TriMesh& input, RemeshResult& result) {
 
 // `options` with the steps that did not run for `result` set to off, for the report's summary:
 // --strict and --no-relax have no shape smoothing, surface relaxation (so no rim sliding), snap,
-// fit or repair; the sphere and the disk have no guarded shape sweeps; and the base-mesh domain
-// has no Lloyd step in D (it relaxes by shape smoothing and area centroids) and repairs its
-// finest level only, before any projection onto the original (remesh/base_route.cpp).
+// fit, untangling or repair; the sphere and the disk have no guarded shape sweeps; and the
+// base-mesh domain has no Lloyd step in D (it relaxes by shape smoothing and area centroids) and
+// repairs its finest level only, before any projection onto the original (remesh/base_route.cpp).
 RemeshOptions options_as_run(const RemeshResult& result, RemeshOptions options) {
   if (options.relax != RelaxMode::all_vertices) {
     options.relaxation.shape_iterations = 0;
@@ -681,6 +682,7 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   j["repair_after_reprojection"] = ran.repair.after_reprojection;
   j["snap_tips"] = ran.snap.max_snaps;
   j["fit_rounds"] = ran.fit.rounds;
+  j["untangle_max_rounds"] = ran.untangle.max_rounds;
   j["base_density_smoothing"] = ran.base.density_smoothing;
   j["max_base_bend"] = ran.base.max_bend;
   j["lloyd_iterations"] = ran.relaxation.lloyd_iterations;

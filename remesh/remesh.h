@@ -178,7 +178,7 @@ struct RemeshOptions {
   /// With all_vertices, after the repair: fit.rounds rounds of the least-squares fit of the
   /// finest level to the input along the vertex normals (remesh/surface_fit.h). The lifted
   /// vertices sit on the input, so every triangle is a chord; the fit centres the triangles on
-  /// the surface. fit.rounds = 0: every vertex stays exactly on the input, as in the paper.
+  /// the surface. fit.rounds = 0: off.
   SurfaceFitOptions fit;
   /// With all_vertices, last on the finest level: the corners of crossing face pairs move to
   /// their neighbours' mean while the count of such pairs falls (remesh/untangle.h), which opens
@@ -196,7 +196,7 @@ struct RemeshOptions {
 
 /// One level of the result.
 struct RemeshLevel {
-  RowMatrixX3d positions;         ///< 3D positions, n_j rows (on the input surface; the finest off it by the fit)
+  RowMatrixX3d positions;         ///< 3D positions, n_j rows (on the input; the finest moved by fit, untangling)
   RowMatrixX3d domain_positions;  ///< positions in D, n_j rows (unit sphere, or z = 1 plane for a disk)
   int flipped_triangles = 0;      ///< triangles with non-positive orientation in D (always 0)
   double seconds = 0;             ///< time spent building this level

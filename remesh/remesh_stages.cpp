@@ -167,8 +167,11 @@ PreparedInput prepare_input(const TriMesh& input, const SimplifyOptions& options
   return p;
 }
 
-nlohmann::json untangle_finest(const RowMatrixX3i& F, RowMatrixX3d& X, const UntangleOptions& options) {
-  const UntangleStats s = untangle_self_intersections(F, X, boundary_vertices(F, static_cast<int>(X.rows())), options);
+nlohmann::json untangle_finest(const RowMatrixX3i& F, RowMatrixX3d& X, const UntangleOptions& options,
+                               const std::vector<bool>& snapped) {
+  std::vector<bool> held = boundary_vertices(F, static_cast<int>(X.rows()));
+  for (std::size_t v = 0; v < snapped.size(); ++v) held[v] = held[v] || snapped[v];
+  const UntangleStats s = untangle_self_intersections(F, X, held, options);
   if (s.pairs_before == 0) return nullptr;
   return {{"pairs_before", s.pairs_before},
           {"pairs_after", s.pairs_after},

@@ -94,9 +94,11 @@ std::shared_ptr<SurfaceLocator> map_beside_locator(const PreparedInput& input, b
 /// Moves every row of X to its closest point on the locator's surface.
 void reproject_onto(const SurfaceLocator& surface, RowMatrixX3d& X);
 
-/// The last stage of the finest level (remesh/untangle.h), a disk's rim held: the record for
-/// level.stats["untangle"] where the level had crossing face pairs, else null.
-nlohmann::json untangle_finest(const RowMatrixX3i& F, RowMatrixX3d& X, const UntangleOptions& options);
+/// The last stage of the finest level (remesh/untangle.h), a disk's rim and the snapped tips
+/// (`snapped`, empty or one flag per vertex) held: the record for level.stats["untangle"] where
+/// the level had crossing face pairs, else null.
+nlohmann::json untangle_finest(const RowMatrixX3i& F, RowMatrixX3d& X, const UntangleOptions& options,
+                               const std::vector<bool>& snapped);
 
 /// Quality, distance to the original input and self-intersecting face pairs
 /// (count_self_intersections), into level.stats.

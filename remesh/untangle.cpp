@@ -1,5 +1,7 @@
 #include "remesh/untangle.h"
 
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "mesh/distance.h"
@@ -48,6 +50,9 @@ RowMatrixX3d umbrella_step(const RowMatrixX3d& X, const RowMatrixX3i& F, const V
 
 UntangleStats untangle_self_intersections(const RowMatrixX3i& F, RowMatrixX3d& X, const std::vector<bool>& fixed,
                                           const UntangleOptions& options) {
+  if (!fixed.empty() && static_cast<Eigen::Index>(fixed.size()) != X.rows())
+    throw std::invalid_argument("untangle_self_intersections: " + std::to_string(fixed.size()) + " fixed flags for " +
+                                std::to_string(X.rows()) + " vertices");
   UntangleStats stats;
   if (options.max_rounds <= 0) return stats;
   FacePairs pairs = crossing_face_pairs(TriMesh{X, F});

@@ -198,7 +198,7 @@ TEST(RemeshOptionsCheck, AValueOutOfRangeIsRefusedByItsKeyWithThePrefix) {
   EXPECT_EQ(refusal(o), "the option fit.regularization is 0; it must be a positive number");
   o = RemeshOptions{};
   o.untangle.max_rounds = -1;
-  EXPECT_NE(refusal(o).find("the option untangle.max_rounds is -1"), std::string::npos) << refusal(o);
+  EXPECT_EQ(refusal(o), "the option untangle.max_rounds is -1; it must be at least 0");
 }
 
 TEST_F(RemeshConfigCli, ReportOptionsRepeatTheRunExactly) {

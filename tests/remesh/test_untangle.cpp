@@ -1,7 +1,9 @@
 // Tests of the untangling of a level that passes through itself (remesh/untangle.h).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <set>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -76,6 +78,28 @@ TEST(Untangle, FixedVerticesStayAndTheCountNeverRises) {
   EXPECT_GT(stats.pairs_after, 0);
   EXPECT_LE(stats.pairs_after, stats.pairs_before);
   EXPECT_EQ(stats.pairs_after, static_cast<int>(crossing_face_pairs(TriMesh{X, p.sphere.F}).size()));
+}
+
+// Two triangles through each other's centre, each alone: the umbrella step turns each into its
+// medial triangle, mirrored through the common centre, so they still cross. The round does
+// not lower the count, and is undone.
+TEST(Untangle, ARoundThatDoesNotLowerTheCountIsUndone) {
+  const double s = std::sqrt(3.0) / 2;
+  RowMatrixX3d X(6, 3);
+  X << 1, 0, 0, -0.5, s, 0, -0.5, -s, 0,                 // in the plane z = 0
+      0, 0, 0.5, 0, 0.5 * s, -0.25, 0, -0.5 * s, -0.25;  // in the plane x = 0
+  RowMatrixX3i F(2, 3);
+  F << 0, 1, 2, 3, 4, 5;
+  ASSERT_EQ(crossing_face_pairs(TriMesh{X, F}).size(), 1u);
+  const RowMatrixX3d before = X;
+  const UntangleStats stats = untangle_self_intersections(F, X, {});
+  EXPECT_EQ(stats.pairs_before, 1);
+  EXPECT_EQ(stats.pairs_after, 1);
+  EXPECT_EQ(stats.rounds, 0);
+  EXPECT_EQ(stats.moved_vertices, 0);
+  EXPECT_EQ(X, before);
+  // A wrong number of fixed flags is refused.
+  EXPECT_THROW(untangle_self_intersections(F, X, std::vector<bool>(5, false)), std::invalid_argument);
 }
 
 TEST(Untangle, ACleanSurfaceOrNoRoundsLeaveEveryVertex) {
