@@ -222,8 +222,7 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
                          " flipped triangles in the base domain; the surface cannot be remeshed well");
   nlohmann::json fit;
   if (finest_full && options.fit.rounds > 0 && ctx.locator) {
-    std::vector<bool> fixed = boundary_vertices(F, static_cast<int>(level.positions.rows()));
-    for (std::size_t v = 0; v < fixed.size(); ++v) fixed[v] = fixed[v] || snapped[v];  // the tips stay on the input
+    const std::vector<bool> fixed = held_vertices(F, static_cast<int>(level.positions.rows()), snapped);
     const SurfaceFitStats s = timed(
         stage_seconds, "fit", [&] { return fit_to_surface(F, level.positions, *ctx.locator, options.fit, fixed); });
     fit = {{"rms_before_mm", s.rms_before}, {"rms_after_mm", s.rms_after}, {"max_offset_mm", s.max_offset}};

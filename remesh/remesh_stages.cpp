@@ -167,11 +167,16 @@ PreparedInput prepare_input(const TriMesh& input, const SimplifyOptions& options
   return p;
 }
 
+std::vector<bool> held_vertices(const RowMatrixX3i& F, int num_vertices, const std::vector<bool>& snapped) {
+  std::vector<bool> held = boundary_vertices(F, num_vertices);
+  for (std::size_t v = 0; v < snapped.size(); ++v) held[v] = held[v] || snapped[v];
+  return held;
+}
+
 nlohmann::json untangle_finest(const RowMatrixX3i& F, RowMatrixX3d& X, const UntangleOptions& options,
                                const std::vector<bool>& snapped) {
-  std::vector<bool> held = boundary_vertices(F, static_cast<int>(X.rows()));
-  for (std::size_t v = 0; v < snapped.size(); ++v) held[v] = held[v] || snapped[v];
-  const UntangleStats s = untangle_self_intersections(F, X, held, options);
+  const UntangleStats s =
+      untangle_self_intersections(F, X, held_vertices(F, static_cast<int>(X.rows()), snapped), options);
   if (s.pairs_before == 0) return nullptr;
   return {{"pairs_before", s.pairs_before},
           {"pairs_after", s.pairs_after},

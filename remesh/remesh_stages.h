@@ -7,6 +7,7 @@
 #include <memory>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -93,6 +94,10 @@ std::shared_ptr<SurfaceLocator> map_beside_locator(const PreparedInput& input, b
 
 /// Moves every row of X to its closest point on the locator's surface.
 void reproject_onto(const SurfaceLocator& surface, RowMatrixX3d& X);
+
+/// The finest level's vertices that its fit and untangling keep in place: a disk's rim, and the
+/// tips snapped onto the input (`snapped`, empty or one flag per vertex).
+std::vector<bool> held_vertices(const RowMatrixX3i& F, int num_vertices, const std::vector<bool>& snapped);
 
 /// The last stage of the finest level (remesh/untangle.h), a disk's rim and the snapped tips
 /// (`snapped`, empty or one flag per vertex) held: the record for level.stats["untangle"] where
