@@ -18,14 +18,12 @@ namespace mrsnake::cli {
 
 namespace {
 
-// A finest level that passes through itself is flagged: its quality figures look fine. The
-// cause varies (a tip thinner than an edge, a fold of the base mesh), and so does the cure.
-void warn_if_self_intersecting(const RemeshResult& result) {
-  const nlohmann::json& finest = result.levels.back().stats;
-  const int pairs = finest.value("self_intersections", 0);
-  if (pairs > 0)
-    warn("the finest level passes through itself at " + std::to_string(pairs) +
-         " face pairs (report.json per_level): check it before use");
+// A finest level that passes through itself, or cuts a part of the input off, is flagged:
+// its quality figures look fine. The cause varies (a tip thinner than an edge, a fold of the
+// base mesh), and so does the cure.
+void warn_about_doubts(const nlohmann::json& report) {
+  for (const auto& reason : report.value("suspect_reasons", nlohmann::json::array()))
+    warn(reason.get<std::string>() + " (report.json per_level): check it before use");
 }
 
 }  // namespace
@@ -132,7 +130,7 @@ void add_remesh_command(CLI::App& app) {
     page.report = report;
     mrsnake::reports::write_remesh_report((dir / "report.html").string(), result, page);
     out.commit();
-    warn_if_self_intersecting(result);
+    warn_about_doubts(report);
     if (args->json) {
       print_json(report);
       return;

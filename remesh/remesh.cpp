@@ -6,9 +6,11 @@
 #include <exception>
 #include <functional>
 #include <future>
+#include <iomanip>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -663,6 +665,25 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   return kept;
 }
 
+std::vector<std::string> finest_level_doubts(const RemeshResult& result) {
+  std::vector<std::string> doubts;
+  if (result.levels.empty()) return doubts;
+  const nlohmann::json& finest = result.levels.back().stats;
+  if (!finest.contains("distance")) return doubts;
+  const int pairs = finest.value("self_intersections", 0);
+  if (pairs > 0) doubts.push_back("the finest level passes through itself at " + std::to_string(pairs) + " face pairs");
+  const double hausdorff = finest["distance"]["hausdorff_mm"].get<double>();
+  const double edge = finest["quality"]["edge_length_mean"].get<double>();
+  if (hausdorff > edge) {
+    std::ostringstream s;
+    s << std::setprecision(2) << "the finest level misses part of the input by " << hausdorff / edge
+      << " times its mean edge length (Hausdorff distance " << finest["distance"]["hausdorff_pct"].get<double>()
+      << " % of the diagonal): a part thinner than an edge was cut";
+    doubts.push_back(s.str());
+  }
+  return doubts;
+}
+
 nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& options) {
   nlohmann::json j;
   j["domain"] = result.domain;
@@ -702,6 +723,11 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   nlohmann::json per_level = nlohmann::json::array();
   for (const auto& level : result.levels) per_level.push_back(level.stats);
   j["per_level"] = per_level;
+  if (!result.levels.empty() && result.levels.back().stats.contains("distance")) {  // measured: judged
+    const std::vector<std::string> doubts = finest_level_doubts(result);
+    j["suspect"] = !doubts.empty();
+    j["suspect_reasons"] = doubts;
+  }
   j["seconds"] = total;
   return j;
 }

@@ -240,7 +240,16 @@ void check_options(const RemeshOptions& options, const std::string& at = "");
 /// \throw OptionsError if check_options refuses the options.
 RemeshResult remesh(const TriMesh& input, const RemeshOptions& options);
 
-/// The report.json document of a result: options, parameterization and every level's stats.
+/// Why the finest level is probably unfit for use, one sentence each; empty when nothing is
+/// doubtful or the levels were not measured (options.compute_stats off). Two faults that the
+/// quality figures do not show: the level passes through itself, or it misses a part of the
+/// input by more than its mean edge length (a tip or a tube thinner than an edge was cut, or a
+/// fold was opened away from the input). The edge is the unit because a Lloyd step cannot
+/// follow a feature narrower than it (docs/remesh.md, "Doubtful results").
+std::vector<std::string> finest_level_doubts(const RemeshResult& result);
+
+/// The report.json document of a result: options, parameterization, every level's stats, and,
+/// where the levels were measured, `suspect` with `suspect_reasons` (finest_level_doubts).
 nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& options);
 
 }  // namespace mrsnake

@@ -141,6 +141,9 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
   const RemeshResult* unrelaxed = options.unrelaxed;
   if (unrelaxed && unrelaxed->levels.size() != result.levels.size()) unrelaxed = nullptr;
 
+  // First what makes the finest level doubtful, which its figures below do not show at a glance.
+  for (const std::string& doubt : finest_level_doubts(result)) page.note("Suspect: " + doubt + ".");
+
   // Settings.
   const nlohmann::json& r = options.report;
   std::vector<std::vector<std::string>> settings;

@@ -125,6 +125,34 @@ TEST(Remesh, EllipsoidNestsExactlyWithoutFlipsInEveryModeAndSphereMap) {
   }
 }
 
+// A needle eight input edges long on a sphere is far thinner than the edges of a 3840-face
+// level: the level cuts it off, and the report says so, with the distance in edges. The same
+// sphere without the needle is not suspect.
+TEST(Remesh, AFinestLevelThatCutsANeedleOffIsSuspect) {
+  TriMesh needle = icosphere(4);  // 5120 faces, edges of about 0.075
+  needle.V.row(0) *= 1.6;
+  const auto finest_doubts = [](const TriMesh& input) {
+    RemeshOptions o = small_options(3, 32);
+    o.compute_stats = true;
+    const RemeshResult r = remesh(input, o);
+    const std::vector<std::string> doubts = finest_level_doubts(r);
+    const nlohmann::json report = remesh_report(r, o);
+    EXPECT_EQ(report["suspect"].get<bool>(), !doubts.empty());
+    EXPECT_EQ(report["suspect_reasons"].get<std::vector<std::string>>(), doubts);
+    const nlohmann::json& finest = r.levels.back().stats;
+    const double hausdorff_in_edges =
+        finest["distance"]["hausdorff_mm"].get<double>() / finest["quality"]["edge_length_mean"].get<double>();
+    return std::make_pair(doubts, hausdorff_in_edges);
+  };
+  const auto [cut, cut_edges] = finest_doubts(needle);
+  EXPECT_GT(cut_edges, 2.0);
+  ASSERT_EQ(cut.size(), 1u);
+  EXPECT_NE(cut[0].find("misses part of the input by"), std::string::npos) << cut[0];
+  const auto [kept, kept_edges] = finest_doubts(icosphere(4));
+  EXPECT_LT(kept_edges, 0.5);
+  EXPECT_TRUE(kept.empty());
+}
+
 TEST(Remesh, FineInputIsSimplifiedThenProjectedBackOntoIt) {
   const TriMesh input = ellipsoid(5);  // 20480 faces
   RemeshOptions o = small_options(2, 20);
@@ -660,8 +688,9 @@ TEST(RemeshCli, WritesNestedLevelsAndReport) {
 
 // The octopus's tentacle tips are thinner than the edges of a 1000-face level: its triangles
 // cross there, and the untangling opens only some of the folds. The count is recorded per
-// level and the finest level's is a warning, as the quality figures alone would not show it.
-TEST(RemeshCli, FlagsAFinestLevelThatPassesThroughItself) {
+// level and the finest level's is a warning, as the quality figures alone would not show it;
+// so is the tentacles' length that the level cuts off.
+TEST(RemeshCli, FlagsAFinestLevelThatPassesThroughItselfOrCutsTipsOff) {
   MRSNAKE_REQUIRE_DATA(octopus, "meshes/octopus.off");
   const auto dir = test::scratch_dir("remesh-crossing");
   const auto r = test::run_mrsnake("-q remesh " + octopus + " -o " + dir.string() + " --faces 1000");
@@ -679,6 +708,9 @@ TEST(RemeshCli, FlagsAFinestLevelThatPassesThroughItself) {
       r.output.find("warning: the finest level passes through itself at " + std::to_string(finest) + " face pairs"),
       std::string::npos)
       << r.output;
+  EXPECT_NE(r.output.find("warning: the finest level misses part of the input by"), std::string::npos) << r.output;
+  EXPECT_TRUE(report["suspect"].get<bool>());
+  EXPECT_EQ(report["suspect_reasons"].size(), 2u);
   std::filesystem::remove_all(dir);
 }
 
