@@ -256,10 +256,15 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
 }  // namespace
 
 RemeshResult remesh_on_base_mesh(const TriMesh& input, const RemeshOptions& options) {
-  RemeshResult result;
   const auto start = Clock::now();
+  PreparedInput prepared = prepare_input(input, options.simplify, initial_resolution(options), options.progress, start);
+  return remesh_on_base_mesh(std::move(prepared), options, start);
+}
+
+RemeshResult remesh_on_base_mesh(remesh_stages::PreparedInput prepared, const RemeshOptions& options,
+                                 remesh_stages::Clock::time_point start) {
+  RemeshResult result;
   Resolution resolution = initial_resolution(options);
-  PreparedInput prepared = prepare_input(input, options.simplify, resolution, options.progress, start);
   // MAPS spreads the base by its removal order, so only the grown size and density are used.
   Eigen::VectorXd wanted =
       sizing_fields(prepared.work, options.sizing, options.base, options.levels != 0, resolution).wanted;

@@ -5,11 +5,19 @@
 /// split and relaxed in the charts of K (remesh/base_levels.h) and lifted through the map's
 /// inverse (remesh/base_lift.h). Internal to the remesh module; remesh() calls it.
 #include "remesh/remesh.h"
+#include "remesh/remesh_stages.h"
 
 namespace mrsnake {
 
 /// \pre the options passed remesh()'s checks; input has faces.
 /// \throw TopologyError, AlgorithmError as remesh().
 RemeshResult remesh_on_base_mesh(const TriMesh& input, const RemeshOptions& options);
+
+/// The same from the input as remesh_stages::prepare_input() left it for these options (the
+/// automatic domain prepares it once for both routes); `start` is when the preparation began,
+/// for the report's seconds.
+/// \throw AlgorithmError as remesh().
+RemeshResult remesh_on_base_mesh(remesh_stages::PreparedInput prepared, const RemeshOptions& options,
+                                 remesh_stages::Clock::time_point start);
 
 }  // namespace mrsnake

@@ -378,12 +378,11 @@ RemeshLevel build_level(const LevelContext& ctx, const RemeshOptions& options, i
 
 // The sphere route: the input mapped onto the unit sphere or disk, the base in D, the levels.
 // `on_hierarchical_fallback` is called when the one-chart sphere map fails (and may stop the route there).
-RemeshResult remesh_on_sphere(const TriMesh& input, const RemeshOptions& options,
+// `prepared` is the input as prepare_input() left it for these options, from `start` on.
+RemeshResult remesh_on_sphere(const PreparedInput& prepared, const RemeshOptions& options, Clock::time_point start,
                               const HierarchicalFallbackFn& on_hierarchical_fallback = {}) {
   RemeshResult result;
-  const auto start = Clock::now();
   Resolution resolution = initial_resolution(options);
-  const PreparedInput prepared = prepare_input(input, options.simplify, resolution, options.progress, start);
   // Like the snap and the repair, the fit is part of the full method only: --no-relax and
   // --strict stay the paper's baseline and exact method, with every vertex on the input.
   const int fit_rounds = options.relax == RelaxMode::all_vertices ? options.fit.rounds : 0;
@@ -416,6 +415,13 @@ RemeshResult remesh_on_sphere(const TriMesh& input, const RemeshOptions& options
     report(options.progress, "level " + std::to_string(j), 1.0);
   }
   return result;
+}
+
+RemeshResult remesh_on_sphere(const TriMesh& input, const RemeshOptions& options) {
+  const auto start = Clock::now();
+  const PreparedInput prepared =
+      prepare_input(input, options.simplify, initial_resolution(options), options.progress, start);
+  return remesh_on_sphere(prepared, options, start);
 }
 
 // What the automatic domain compares of two finest levels.
@@ -465,7 +471,8 @@ struct BaseOutcome {
 // kept, not thrown. Destroyed while running (the sphere route threw), it waits for the end.
 class BaseRouteBeside {
  public:
-  BaseRouteBeside(const TriMesh& input, RemeshOptions options) : input_(input), options_(std::move(options)) {}
+  BaseRouteBeside(const PreparedInput& prepared, RemeshOptions options)
+      : prepared_(prepared), options_(std::move(options)) {}
   BaseRouteBeside(const BaseRouteBeside&) = delete;  // the running thread holds `this`
   BaseRouteBeside& operator=(const BaseRouteBeside&) = delete;
 
@@ -492,7 +499,9 @@ class BaseRouteBeside {
   BaseOutcome run() const {
     BaseOutcome out;
     try {
-      out.result = remesh_on_base_mesh(input_, options_);
+      // From a copy, which the route refines. Its seconds start here: the shared preparation
+      // counts with the sphere route's (the domain choice's seconds), where the base mesh wins.
+      out.result = remesh_on_base_mesh(prepared_, options_, Clock::now());
       out.score = finest_level_score(*out.result);
     } catch (const std::exception& e) {
       out.result.reset();
@@ -501,7 +510,7 @@ class BaseRouteBeside {
     return out;
   }
 
-  const TriMesh& input_;
+  const PreparedInput& prepared_;  // read by both routes, changed by neither
   const RemeshOptions options_;
   std::future<BaseOutcome> running_;
 };
@@ -567,8 +576,9 @@ RemeshResult base_instead_of_sphere(BaseOutcome on_base, const std::exception_pt
 // mesh's result, which holds protrusions; if it failed, the sphere route on the hierarchical
 // map after all (straight away: the one-chart map is known to fail), with the base mesh's
 // failure recorded.
-RemeshResult base_alone_or_hierarchical_sphere(BaseOutcome on_base, const std::string& reason, const TriMesh& input,
-                                               RemeshOptions sphere_options, Clock::time_point start) {
+RemeshResult base_alone_or_hierarchical_sphere(BaseOutcome on_base, const std::string& reason,
+                                               const PreparedInput& prepared, RemeshOptions sphere_options,
+                                               Clock::time_point start) {
   nlohmann::json choice = {{"sphere_map_fallback", reason}};
   if (on_base.result) {
     choice["sphere"] = {{"skipped", "the one-chart map's squeeze: protrusions, which the base mesh holds"}};
@@ -577,7 +587,7 @@ RemeshResult base_alone_or_hierarchical_sphere(BaseOutcome on_base, const std::s
                               "the one-chart map squeezed the shape: the base mesh alone", start);
   }
   sphere_options.sphere_map = SphereMap::hierarchical;
-  RemeshResult on_sphere = remesh_on_sphere(input, sphere_options);
+  RemeshResult on_sphere = remesh_on_sphere(prepared, sphere_options, Clock::now());
   choice["sphere"] = score_json(finest_level_score(on_sphere));
   choice["base_mesh"] = {{"error", on_base.error}};
   return with_domain_choice(std::move(on_sphere), std::move(choice), "the base mesh's route failed", start);
@@ -634,8 +644,12 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   unmeasured.compute_stats = false;
   unmeasured.keep_input_locator = options.keep_input_locator || options.compute_stats;
   const auto progress_lock = std::make_shared<std::mutex>();
-  BaseRouteBeside on_base(input, with_locked_progress(unmeasured, progress_lock, "base-mesh domain: "));
   const RemeshOptions sphere_options = with_locked_progress(unmeasured, progress_lock, "");
+  // Both routes start from the same prepared input (a simplification or a remeshing of large
+  // slivers, on some inputs the longest stage of all): prepared once.
+  const PreparedInput prepared =
+      prepare_input(input, options.simplify, initial_resolution(options), sphere_options.progress, start);
+  BaseRouteBeside on_base(prepared, with_locked_progress(unmeasured, progress_lock, "base-mesh domain: "));
   std::optional<std::string> squeeze;  // why the sphere route stopped at its one-chart map, if it did
   const auto on_fallback = [&](const OneChartFailure& failure) {
     on_base.start();
@@ -648,13 +662,13 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   std::optional<RemeshResult> on_sphere;
   std::exception_ptr sphere_failure;
   try {
-    on_sphere = remesh_on_sphere(input, sphere_options, on_fallback);
+    on_sphere = remesh_on_sphere(prepared, sphere_options, start, on_fallback);
   } catch (const AlgorithmError&) {  // the base mesh may still hold the shape (built now, if not begun)
     sphere_failure = std::current_exception();
   }
   RemeshResult kept;
   if (squeeze)
-    kept = base_alone_or_hierarchical_sphere(on_base.outcome(), *squeeze, input, sphere_options, start);
+    kept = base_alone_or_hierarchical_sphere(on_base.outcome(), *squeeze, prepared, sphere_options, start);
   else if (!on_sphere)
     kept = base_instead_of_sphere(on_base.outcome(), sphere_failure, start);
   else if (on_the_hierarchical_map(*on_sphere))

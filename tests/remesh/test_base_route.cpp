@@ -516,6 +516,37 @@ TEST(AutomaticDomain, AShapeTheOneChartMapSqueezesIsBuiltOnTheBaseMeshAlone) {
   expect_valid_hierarchy(instead, capsule);
 }
 
+// The input's large slivers are remeshed once, for both routes: the stage is reported once, by
+// the caller's thread, and the base mesh's levels are those it builds alone (which remeshes
+// them itself).
+TEST(AutomaticDomain, BothRoutesStartFromOneRemeshingOfTheSlivers) {
+  const TriMesh capsule = test::capsule(40.0, 16, 4.0);  // squeezed by one chart, its tube of slivers
+  RemeshOptions o;
+  o.target_faces = 1024;
+  o.compute_stats = false;
+  std::vector<std::string> sliver_stages;
+  const std::thread::id caller = std::this_thread::get_id();
+  bool other_thread = false;
+  o.progress = [&](const std::string& stage, double fraction) {
+    if (stage.find("remesh the slivers") != std::string::npos && fraction == 0) {
+      sliver_stages.push_back(stage);
+      other_thread = other_thread || std::this_thread::get_id() != caller;
+    }
+  };
+  const RemeshResult r = remesh(capsule, o);
+  ASSERT_EQ(r.domain, "base_mesh");
+  EXPECT_TRUE(r.parameterization.at("sliver_remeshed").get<bool>());
+  EXPECT_EQ(sliver_stages, std::vector<std::string>{"remesh the slivers"});
+  EXPECT_FALSE(other_thread);
+  RemeshOptions alone = o;
+  alone.domain = ParameterDomain::base_mesh;
+  alone.progress = nullptr;
+  const RemeshResult on_base = remesh(capsule, alone);
+  ASSERT_EQ(on_base.levels.size(), r.levels.size());
+  for (std::size_t j = 0; j < r.levels.size(); ++j)
+    EXPECT_EQ(r.levels[j].positions, on_base.levels[j].positions) << "level " << j;
+}
+
 // Where the sphere route fails (here its progress callback throws at its first level), the base
 // mesh's result stands in: on a capsule it was built beside the hierarchical map (both domains
 // built, as where the one-chart map only flips), on an ellipsoid (one chart holds it) it is built
