@@ -274,17 +274,11 @@ TriangleRepairStats repair_level(const LevelContext& ctx, const RepairOptions& o
 // the snapped tips stay exactly on the input's tips (they were kept for lowering the largest
 // distance).
 SurfaceFitStats fit_finest(const LevelContext& ctx, const SurfaceFitOptions& options, int j,
-                           const std::vector<bool>& snapped, int snapped_count, RowMatrixX3d& X) {
+                           const std::vector<bool>& snapped, RowMatrixX3d& X) {
   const RowMatrixX3i& F = ctx.connectivity.faces[j];
   SurfaceFitOptions fit = options;
   fit.rounds = ctx.fit_rounds;
-  std::vector<bool> fixed =
-      ctx.kind == DomainKind::disk ? boundary_vertices(F, static_cast<int>(X.rows())) : std::vector<bool>{};
-  if (snapped_count > 0) {
-    if (fixed.empty()) fixed.assign(snapped.size(), false);
-    for (std::size_t v = 0; v < snapped.size(); ++v) fixed[v] = fixed[v] || snapped[v];
-  }
-  return fit_to_surface(F, X, *ctx.locator, fit, fixed);
+  return fit_to_surface(F, X, *ctx.locator, fit, held_vertices(F, static_cast<int>(X.rows()), snapped));
 }
 
 // What the stages did, for RemeshLevel::stats.
@@ -363,8 +357,7 @@ RemeshLevel build_level(const LevelContext& ctx, const RemeshOptions& options, i
     throw AlgorithmError("level " + std::to_string(j) + " has " + std::to_string(flipped) +
                          " flipped triangles in the domain; the surface cannot be remeshed well");
   r.fitted = ctx.fit_rounds > 0 && finest;
-  if (r.fitted)
-    r.fit = timed(stage, "fit", [&] { return fit_finest(ctx, options.fit, j, snapped, r.snapped, level.positions); });
+  if (r.fitted) r.fit = timed(stage, "fit", [&] { return fit_finest(ctx, options.fit, j, snapped, level.positions); });
   if (full && finest && options.untangle.max_rounds > 0)
     r.untangle =
         timed(stage, "untangle", [&] { return untangle_finest(F, level.positions, options.untangle, snapped); });
