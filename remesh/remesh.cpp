@@ -683,9 +683,10 @@ std::vector<std::string> finest_level_doubts(const RemeshResult& result) {
   const double edge = finest["quality"]["edge_length_mean"].get<double>();
   if (hausdorff > edge) {
     std::ostringstream s;
-    s << std::setprecision(2) << "the finest level misses part of the input by " << hausdorff / edge
-      << " times its mean edge length (Hausdorff distance " << finest["distance"]["hausdorff_pct"].get<double>()
-      << " % of the diagonal): a part thinner than an edge was cut";
+    s << "the finest level misses part of the input by " << std::fixed << std::setprecision(1) << hausdorff / edge
+      << " times its mean edge length (Hausdorff distance " << std::defaultfloat << std::setprecision(2)
+      << finest["distance"]["hausdorff_pct"].get<double>()
+      << " % of the diagonal): a sharp tip or corner, or a part thinner than an edge, was cut off";
     doubts.push_back(s.str());
   }
   return doubts;

@@ -243,9 +243,9 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options);
 /// Why the finest level is probably unfit for use, one sentence each; empty when nothing is
 /// doubtful or the levels were not measured (options.compute_stats off). Two faults that the
 /// quality figures do not show: the level passes through itself, or it misses a part of the
-/// input by more than its mean edge length (a tip or a tube thinner than an edge was cut, or a
-/// fold was opened away from the input). The edge is the unit because a Lloyd step cannot
-/// follow a feature narrower than it (docs/remesh.md, "Doubtful results").
+/// input by more than its mean edge length (a sharp tip or corner, or a tube thinner than an
+/// edge, was cut off, or a fold was opened away from the input). The edge is the unit because a
+/// Lloyd step cannot follow a feature narrower than it (docs/remesh.md, "Doubtful results").
 std::vector<std::string> finest_level_doubts(const RemeshResult& result);
 
 /// The report.json document of a result: options, parameterization, every level's stats, and,
