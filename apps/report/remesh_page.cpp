@@ -220,8 +220,8 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
                    (samples > 0 ? " plus " + std::to_string(samples) + " random point(s) per face" : std::string()) +
                    " of each mesh (a uniform random subset of " + std::to_string(kMaxDistanceSamples) +
                    " of them for a mesh with more: the RMS is an unbiased estimate, the Hausdorff distance the largest "
-                   "over the subset), measured against the other (report.json has none: run with --full-report for "
-                   "remesh's own figures).");
+                   "over the subset), measured against the other (report.json has none: build-model's "
+                   "\"report\": {\"level_stats\": true} in --config gives the remeshing's own figures).");
   if (distance_missing) page.note("The geometric error needs the input surface; it was not given to this page.");
 
   // Renders of every level.
