@@ -23,7 +23,7 @@ namespace {
 // base mesh), and so does the cure.
 void warn_about_doubts(const nlohmann::json& report) {
   for (const auto& reason : report.value("suspect_reasons", nlohmann::json::array()))
-    warn(reason.get<std::string>() + " (report.json per_level): check it before use");
+    warn(reason.get<std::string>() + "; check it before use (report.json suspect_reasons)");
 }
 
 }  // namespace

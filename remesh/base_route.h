@@ -13,9 +13,10 @@ namespace mrsnake {
 /// \throw TopologyError, AlgorithmError as remesh().
 RemeshResult remesh_on_base_mesh(const TriMesh& input, const RemeshOptions& options);
 
-/// The same from the input as remesh_stages::prepare_input() left it for these options (the
-/// automatic domain prepares it once for both routes); `start` is when the preparation began,
-/// for the report's seconds.
+/// The same from an input already prepared (the automatic domain prepares it once for both
+/// routes); the report's seconds count from `start`.
+/// \pre prepared is remesh_stages::prepare_input(input, options.simplify,
+///      initial_resolution(options), ...); the options passed remesh()'s checks.
 /// \throw AlgorithmError as remesh().
 RemeshResult remesh_on_base_mesh(remesh_stages::PreparedInput prepared, const RemeshOptions& options,
                                  remesh_stages::Clock::time_point start);

@@ -371,7 +371,8 @@ RemeshLevel build_level(const LevelContext& ctx, const RemeshOptions& options, i
 
 // The sphere route: the input mapped onto the unit sphere or disk, the base in D, the levels.
 // `on_hierarchical_fallback` is called when the one-chart sphere map fails (and may stop the route there).
-// `prepared` is the input as prepare_input() left it for these options, from `start` on.
+// `prepared` is prepare_input(input, options.simplify, initial_resolution(options), ...); the
+// report's seconds count from `start`.
 RemeshResult remesh_on_sphere(const PreparedInput& prepared, const RemeshOptions& options, Clock::time_point start,
                               const HierarchicalFallbackFn& on_hierarchical_fallback = {}) {
   RemeshResult result;
@@ -462,6 +463,7 @@ struct BaseOutcome {
 // fails, beside the hierarchical map and the sphere's levels: the automatic domain then takes
 // about the longer route's time instead of both routes' sum. Its failure, for any reason, is
 // kept, not thrown. Destroyed while running (the sphere route threw), it waits for the end.
+// `prepared` must outlive it: its thread reads it (declare it first).
 class BaseRouteBeside {
  public:
   BaseRouteBeside(const PreparedInput& prepared, RemeshOptions options)
@@ -672,21 +674,20 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   return kept;
 }
 
-std::vector<std::string> finest_level_doubts(const RemeshResult& result) {
-  std::vector<std::string> doubts;
-  if (result.levels.empty()) return doubts;
+std::optional<std::vector<std::string>> finest_level_doubts(const RemeshResult& result) {
+  if (result.levels.empty() || !result.levels.back().stats.contains("distance")) return std::nullopt;
   const nlohmann::json& finest = result.levels.back().stats;
-  if (!finest.contains("distance")) return doubts;
-  const int pairs = finest.value("self_intersections", 0);
+  std::vector<std::string> doubts;
+  const int pairs = finest.at("self_intersections").get<int>();
   if (pairs > 0) doubts.push_back("the finest level passes through itself at " + std::to_string(pairs) + " face pairs");
-  const double hausdorff = finest["distance"]["hausdorff_mm"].get<double>();
-  const double edge = finest["quality"]["edge_length_mean"].get<double>();
+  const double hausdorff = finest.at("distance").at("hausdorff_mm").get<double>();
+  const double edge = finest.at("quality").at("edge_length_mean").get<double>();
   if (hausdorff > edge) {
     std::ostringstream s;
-    s << "the finest level misses part of the input by " << std::fixed << std::setprecision(1) << hausdorff / edge
-      << " times its mean edge length (Hausdorff distance " << std::defaultfloat << std::setprecision(2)
-      << finest["distance"]["hausdorff_pct"].get<double>()
-      << " % of the diagonal): a sharp tip or corner, or a part thinner than an edge, was cut off";
+    s << "the finest level misses part of the input by more than its mean edge length (Hausdorff distance "
+      << std::fixed << std::setprecision(2) << hausdorff / edge << " mean edges, " << std::defaultfloat
+      << finest.at("distance").at("hausdorff_pct").get<double>()
+      << " % of the diagonal), probably a sharp tip or corner, or a part thinner than an edge, cut off";
     doubts.push_back(s.str());
   }
   return doubts;
@@ -731,10 +732,9 @@ nlohmann::json remesh_report(const RemeshResult& result, const RemeshOptions& op
   nlohmann::json per_level = nlohmann::json::array();
   for (const auto& level : result.levels) per_level.push_back(level.stats);
   j["per_level"] = per_level;
-  if (!result.levels.empty() && result.levels.back().stats.contains("distance")) {  // measured: judged
-    const std::vector<std::string> doubts = finest_level_doubts(result);
-    j["suspect"] = !doubts.empty();
-    j["suspect_reasons"] = doubts;
+  if (const auto doubts = finest_level_doubts(result)) {  // judged where measured
+    j["suspect"] = !doubts->empty();
+    j["suspect_reasons"] = *doubts;
   }
   j["seconds"] = total;
   return j;

@@ -8,6 +8,7 @@
 /// Domain: a closed genus-0 input is mapped onto the unit sphere (the boundary of a convex
 /// body; no seam), a disk input onto the unit disk (boundary on the circle).
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -240,13 +241,17 @@ void check_options(const RemeshOptions& options, const std::string& at = "");
 /// \throw OptionsError if check_options refuses the options.
 RemeshResult remesh(const TriMesh& input, const RemeshOptions& options);
 
-/// Why the finest level is probably unfit for use, one sentence each; empty when nothing is
-/// doubtful or the levels were not measured (options.compute_stats off). Two faults that the
-/// quality figures do not show: the level passes through itself, or it misses a part of the
-/// input by more than its mean edge length (a sharp tip or corner, or a tube thinner than an
-/// edge, was cut off, or a fold was opened away from the input). The edge is the unit because a
-/// Lloyd step cannot follow a feature narrower than it (docs/remesh.md, "Doubtful results").
-std::vector<std::string> finest_level_doubts(const RemeshResult& result);
+/// Why the finest level is probably unfit for use, one sentence each (empty: nothing is
+/// doubtful), or nullopt where the levels were not measured (options.compute_stats off). Two
+/// faults that the quality figures do not show: the level passes through itself, or it misses
+/// a part of the input by more than its mean edge length (a sharp tip or corner, or a tube
+/// thinner than an edge, was cut off, or a fold was opened away from the input). The edge is
+/// the unit because a Lloyd step cannot follow a feature narrower than it (docs/remesh.md,
+/// "Doubtful results"). The distance is the level's measured Hausdorff distance, over at most
+/// 50k sampled points per surface: on a larger input, a lower bound.
+/// \pre result's levels were measured as remesh() measures them, or not at all.
+/// \throw nlohmann::json::exception if the finest level's stats lack a figure the rule reads.
+std::optional<std::vector<std::string>> finest_level_doubts(const RemeshResult& result);
 
 /// The report.json document of a result: options, parameterization, every level's stats, and,
 /// where the levels were measured, `suspect` with `suspect_reasons` (finest_level_doubts).

@@ -76,7 +76,8 @@ struct PreparedInput {
 };
 
 /// \throw TopologyError if the input is neither a disk nor a closed genus-0 surface, or its faces
-/// are oriented inconsistently.
+/// are oriented inconsistently; AlgorithmError if the simplification or the remeshing of the
+/// large slivers fails.
 PreparedInput prepare_input(const TriMesh& input, const SimplifyOptions& options, const Resolution& resolution,
                             const ProgressFn& progress, Clock::time_point start);
 

@@ -142,7 +142,8 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
   if (unrelaxed && unrelaxed->levels.size() != result.levels.size()) unrelaxed = nullptr;
 
   // First what makes the finest level doubtful, which its figures below do not show at a glance.
-  for (const std::string& doubt : finest_level_doubts(result)) page.note("Suspect: " + doubt + ".");
+  for (const std::string& doubt : finest_level_doubts(result).value_or(std::vector<std::string>{}))
+    page.note("Suspect: " + doubt + ".");
 
   // Settings.
   const nlohmann::json& r = options.report;
@@ -220,7 +221,7 @@ std::string remesh_report_html(const RemeshResult& result, const RemeshPageOptio
                    (samples > 0 ? " plus " + std::to_string(samples) + " random point(s) per face" : std::string()) +
                    " of each mesh (a uniform random subset of " + std::to_string(kMaxDistanceSamples) +
                    " of them for a mesh with more: the RMS is an unbiased estimate, the Hausdorff distance the largest "
-                   "over the subset), measured against the other (report.json has none: build-model's "
+                   "over the subset), measured against the other (model.json's remesh_quality has none: build-model's "
                    "\"report\": {\"level_stats\": true} in --config gives the remeshing's own figures).");
   if (distance_missing) page.note("The geometric error needs the input surface; it was not given to this page.");
 

@@ -135,7 +135,7 @@ TEST(Remesh, AFinestLevelThatCutsANeedleOffIsSuspect) {
     RemeshOptions o = small_options(3, 32);
     o.compute_stats = true;
     const RemeshResult r = remesh(input, o);
-    const std::vector<std::string> doubts = finest_level_doubts(r);
+    const std::vector<std::string> doubts = finest_level_doubts(r).value();
     const nlohmann::json report = remesh_report(r, o);
     EXPECT_EQ(report["suspect"].get<bool>(), !doubts.empty());
     EXPECT_EQ(report["suspect_reasons"].get<std::vector<std::string>>(), doubts);
@@ -151,6 +151,11 @@ TEST(Remesh, AFinestLevelThatCutsANeedleOffIsSuspect) {
   const auto [kept, kept_edges] = finest_doubts(icosphere(4));
   EXPECT_LT(kept_edges, 0.5);
   EXPECT_TRUE(kept.empty());
+  // Unmeasured levels are not judged: no verdict, rather than a "not suspect" that nothing backs.
+  RemeshOptions unmeasured = small_options(3, 32);
+  const RemeshResult r = remesh(needle, unmeasured);
+  EXPECT_FALSE(finest_level_doubts(r).has_value());
+  EXPECT_FALSE(remesh_report(r, unmeasured).contains("suspect"));
 }
 
 TEST(Remesh, FineInputIsSimplifiedThenProjectedBackOntoIt) {
@@ -708,7 +713,9 @@ TEST(RemeshCli, FlagsAFinestLevelThatPassesThroughItselfOrCutsTipsOff) {
       r.output.find("warning: the finest level passes through itself at " + std::to_string(finest) + " face pairs"),
       std::string::npos)
       << r.output;
-  EXPECT_NE(r.output.find("warning: the finest level misses part of the input by"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("warning: the finest level misses part of the input by more than its mean edge length"),
+            std::string::npos)
+      << r.output;
   EXPECT_TRUE(report["suspect"].get<bool>());
   EXPECT_EQ(report["suspect_reasons"].size(), 2u);
   std::filesystem::remove_all(dir);
