@@ -257,8 +257,7 @@ RemeshLevel build_base_level(const BaseContext& ctx, const RemeshOptions& option
 
 RemeshResult remesh_on_base_mesh(const TriMesh& input, const RemeshOptions& options) {
   const auto start = Clock::now();
-  PreparedInput prepared = prepare_input(input, options.simplify, initial_resolution(options), options.progress, start);
-  return remesh_on_base_mesh(std::move(prepared), options, start);
+  return remesh_on_base_mesh(prepare_input(input, options, start), options, start);
 }
 
 RemeshResult remesh_on_base_mesh(remesh_stages::PreparedInput prepared, const RemeshOptions& options,

@@ -15,8 +15,8 @@ RemeshResult remesh_on_base_mesh(const TriMesh& input, const RemeshOptions& opti
 
 /// The same from an input already prepared (the automatic domain prepares it once for both
 /// routes); the report's seconds count from `start`.
-/// \pre prepared is remesh_stages::prepare_input(input, options.simplify,
-///      initial_resolution(options), ...); the options passed remesh()'s checks.
+/// \pre prepared is remesh_stages::prepare_input(input, options, ...); the options passed
+///      remesh()'s checks.
 /// \throw AlgorithmError as remesh().
 RemeshResult remesh_on_base_mesh(remesh_stages::PreparedInput prepared, const RemeshOptions& options,
                                  remesh_stages::Clock::time_point start);

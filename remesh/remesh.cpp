@@ -371,8 +371,7 @@ RemeshLevel build_level(const LevelContext& ctx, const RemeshOptions& options, i
 
 // The sphere route: the input mapped onto the unit sphere or disk, the base in D, the levels.
 // `on_hierarchical_fallback` is called when the one-chart sphere map fails (and may stop the route there).
-// `prepared` is prepare_input(input, options.simplify, initial_resolution(options), ...); the
-// report's seconds count from `start`.
+// `prepared` is prepare_input(input, options, ...); the report's seconds count from `start`.
 RemeshResult remesh_on_sphere(const PreparedInput& prepared, const RemeshOptions& options, Clock::time_point start,
                               const HierarchicalFallbackFn& on_hierarchical_fallback = {}) {
   RemeshResult result;
@@ -413,9 +412,7 @@ RemeshResult remesh_on_sphere(const PreparedInput& prepared, const RemeshOptions
 
 RemeshResult remesh_on_sphere(const TriMesh& input, const RemeshOptions& options) {
   const auto start = Clock::now();
-  const PreparedInput prepared =
-      prepare_input(input, options.simplify, initial_resolution(options), options.progress, start);
-  return remesh_on_sphere(prepared, options, start);
+  return remesh_on_sphere(prepare_input(input, options, start), options, start);
 }
 
 // What the automatic domain compares of two finest levels.
@@ -642,8 +639,7 @@ RemeshResult remesh(const TriMesh& input, const RemeshOptions& options) {
   const RemeshOptions sphere_options = with_locked_progress(unmeasured, progress_lock, "");
   // Both routes start from the same prepared input (a simplification or a remeshing of large
   // slivers, on some inputs the longest stage of all): prepared once.
-  const PreparedInput prepared =
-      prepare_input(input, options.simplify, initial_resolution(options), sphere_options.progress, start);
+  const PreparedInput prepared = prepare_input(input, sphere_options, start);
   BaseRouteBeside on_base(prepared, with_locked_progress(unmeasured, progress_lock, "base-mesh domain: "));
   std::optional<std::string> squeeze;  // why the sphere route stopped at its one-chart map, if it did
   const auto on_fallback = [&](const OneChartFailure& failure) {

@@ -146,24 +146,24 @@ void remesh_large_slivers(const TopologyReport& topology, const SimplifyOptions&
 // simplification of it when it is much finer than the finest level (the parameterization is
 // the costly part), or an isotropic remeshing of it when it is made of large slivers.
 
-// \throw TopologyError if the input is neither a disk nor a closed genus-0 surface, or its faces
-// are oriented inconsistently.
-PreparedInput prepare_input(const TriMesh& input, const SimplifyOptions& options, const Resolution& resolution,
-                            const ProgressFn& progress, Clock::time_point start) {
+PreparedInput prepare_input(const TriMesh& input, const RemeshOptions& options, Clock::time_point start) {
+  const SimplifyOptions& simplify = options.simplify;
+  const Resolution resolution = initial_resolution(options);
+  const ProgressFn& progress = options.progress;
   PreparedInput p;
   p.original = remove_unreferenced_vertices(input);
   const TopologyReport topology = topology_report(p.original);
   require_disk_or_sphere(topology, "the input surface");
   p.work = p.original;
   const double finest_faces = 2.0 * resolution.base_vertices * std::pow(4.0, resolution.levels);
-  const double limit = std::max<double>(options.above_faces, 8 * finest_faces);
-  if (options.above_faces > 0 && p.original.num_faces() > limit) {
+  const double limit = std::max<double>(simplify.above_faces, 8 * finest_faces);
+  if (simplify.above_faces > 0 && p.original.num_faces() > limit) {
     report(progress, "simplify", 0);
     stand_in(topology, simplify_to_faces(p.original, static_cast<int>(limit)), p);
     p.simplify_info["simplify_seconds"] = seconds_since(start);
     return p;
   }
-  remesh_large_slivers(topology, options, finest_faces, progress, start, p);
+  remesh_large_slivers(topology, simplify, finest_faces, progress, start, p);
   return p;
 }
 

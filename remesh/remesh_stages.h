@@ -75,11 +75,12 @@ struct PreparedInput {
   nlohmann::json simplify_info;  ///< simplify_seconds, or sliver_share, sliver_remeshed and sliver_remesh_seconds
 };
 
+/// The input for `options` (options.simplify at initial_resolution(options), progress to
+/// options.progress), the same for both routes; the report's seconds count from `start`.
 /// \throw TopologyError if the input is neither a disk nor a closed genus-0 surface, or its faces
 /// are oriented inconsistently; AlgorithmError if the simplification or the remeshing of the
 /// large slivers fails.
-PreparedInput prepare_input(const TriMesh& input, const SimplifyOptions& options, const Resolution& resolution,
-                            const ProgressFn& progress, Clock::time_point start);
+PreparedInput prepare_input(const TriMesh& input, const RemeshOptions& options, Clock::time_point start);
 
 /// Runs `map` (the parameterization of input.work) on this core and, when needs_locator, builds
 /// the original's closest-point tree on the other meanwhile (for the reprojection, the fit and
